@@ -1,0 +1,424 @@
+//! A planar flexible beam in one floating frame (planar paper §3, eq. (1)–(13)).
+//!
+//! Body coordinates z = [R_x, R_y, θ, q_f]: the world position and angle of the reference frame
+//! (at flange a) and the deformation coordinates left after the boundary conditions of §3.3.
+//! Every shape integral of eq. (11) is computed once, here, with 4-point Gauss per element; each
+//! evaluation only combines them with the current q_f. The equations are written in world
+//! components for R (so joints and gravity stay simple), which is eq. (5) rotated by A.
+//!
+//! Residual of the body (generalized inertia + internal - applied forces):
+//! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
+//! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
+
+use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
+use super::section::Section;
+use crate::scene::{BeamSpec, FrameKind};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix2, Vector2};
+
+/// Index of the angle θ in the body coordinates; q_f starts at [`FLEX`].
+pub const THETA: usize = 2;
+pub const FLEX: usize = 3;
+
+/// Rotation matrix A(θ) and its derivative A_θ.
+pub fn rot(theta: f64) -> (Matrix2<f64>, Matrix2<f64>) {
+    let (s, c) = theta.sin_cos();
+    (Matrix2::new(c, -s, s, c), Matrix2::new(-s, -c, c, -s))
+}
+
+/// A material point of the beam expressed through q_f: ū = s0 + S_p q_f, slope angle S_φ q_f.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointMap {
+    /// Undeformed position in the beam frame (m).
+    pub s0: Vector2<f64>,
+    /// Deformation displacement per q_f (2 × nf).
+    pub sp: DMatrix<f64>,
+    /// Rotation of the section per q_f (1 × nf, stored as a vector).
+    pub sphi: DVector<f64>,
+}
+
+/// The assembled beam: constants of eq. (11) reduced to the kept deformation coordinates.
+#[derive(Debug, Clone)]
+pub struct PlanarBeam {
+    pub name: String,
+    pub length: f64,
+    pub elements: usize,
+    pub frame: FrameKind,
+    pub section: Section,
+    /// Mass per unit length ρA (kg/m), EA (N), EJ (N m^2).
+    pub mu: f64,
+    pub ea: f64,
+    pub ej: f64,
+    pub rayleigh_alpha: f64,
+    pub rayleigh_beta: f64,
+    /// Full nodal indices (3 per node) kept by the boundary conditions of §3.3.
+    pub kept: Vec<usize>,
+    /// Total mass m.
+    pub mass: f64,
+    /// ∫ρ ū0 dV (S̄_t of the undeformed beam).
+    pub st0: Vector2<f64>,
+    /// ∫ρ ū0ᵀū0 dV.
+    pub i0: f64,
+    /// S̄ = ∫ρ S dV (2 × nf).
+    pub sbar: DMatrix<f64>,
+    /// a = ∫ρ Sᵀ ū0 dV.
+    pub a: DVector<f64>,
+    /// b = ∫ρ (ū0₁ S₂ - ū0₂ S₁) dV, the constant part of Ī_θf.
+    pub b: DVector<f64>,
+    /// m_ff = ∫ρ SᵀS dV.
+    pub mff: DMatrix<f64>,
+    /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
+    pub w: DMatrix<f64>,
+    pub kff: DMatrix<f64>,
+    /// D_ff = alpha m_ff + beta K_ff.
+    pub dff: DMatrix<f64>,
+    pub flange_a: PointMap,
+    pub flange_b: PointMap,
+}
+
+/// Full-beam integrals before the boundary conditions remove coordinates.
+struct FullIntegrals {
+    sbar: DMatrix<f64>,
+    a: DVector<f64>,
+    b: DVector<f64>,
+    mff: DMatrix<f64>,
+    w: DMatrix<f64>,
+    kff: DMatrix<f64>,
+}
+
+impl PlanarBeam {
+    /// Builds the beam from its (validated) scene entry.
+    pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
+        let section = Section::from_spec(&spec.section);
+        PlanarBeam::new(
+            &spec.name,
+            spec.length,
+            spec.elements,
+            spec.frame,
+            spec.material.rho,
+            spec.material.e,
+            section,
+            spec.rayleigh.alpha,
+            spec.rayleigh.beta,
+        )
+    }
+
+    pub fn new(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FrameKind,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+    ) -> PlanarBeam {
+        let n_full = 3 * (elements + 1);
+        let kept: Vec<usize> = (0..n_full)
+            .filter(|&i| match frame {
+                FrameKind::Tangent => i >= 3,
+                FrameKind::Pinned => i >= 2 && i != 3 * elements + 1,
+            })
+            .collect();
+        let mu = rho * section.area;
+        let ea = e * section.area;
+        let ej = e * section.second_moment;
+        let full = full_integrals(length, elements, mu, ea, ej);
+        let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
+        let pick = |m: &DMatrix<f64>| m.select_rows(kept.iter()).select_columns(kept.iter());
+        let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
+        let mff = pick(&full.mff);
+        let kff = pick(&full.kff);
+        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
+        let mass = mu * length;
+        let node_map = |node: usize, x: f64| {
+            let mut sp_full = DMatrix::zeros(2, n_full);
+            sp_full[(0, 3 * node)] = 1.0;
+            sp_full[(1, 3 * node + 1)] = 1.0;
+            let mut sphi_full = DVector::zeros(n_full);
+            sphi_full[3 * node + 2] = 1.0;
+            PointMap {
+                s0: Vector2::new(x, 0.0),
+                sp: pick_cols(&sp_full),
+                sphi: pick_v(&sphi_full),
+            }
+        };
+        PlanarBeam {
+            name: name.to_string(),
+            length,
+            elements,
+            frame,
+            section,
+            mu,
+            ea,
+            ej,
+            rayleigh_alpha,
+            rayleigh_beta,
+            mass,
+            st0: Vector2::new(mass * length / 2.0, 0.0),
+            i0: mass * length * length / 3.0,
+            sbar: pick_cols(&full.sbar),
+            a: pick_v(&full.a),
+            b: pick_v(&full.b),
+            w: pick(&full.w),
+            mff,
+            kff,
+            dff,
+            flange_a: node_map(0, 0.0),
+            flange_b: node_map(elements, length),
+            kept,
+        }
+    }
+
+    /// Number of deformation coordinates nf.
+    pub fn nflex(&self) -> usize {
+        self.kept.len()
+    }
+
+    /// Number of body coordinates 3 + nf.
+    pub fn ndof(&self) -> usize {
+        FLEX + self.nflex()
+    }
+
+    /// Reduced index of the full nodal coordinate `full`, if the boundary conditions keep it.
+    pub fn flex_index(&self, full: usize) -> Option<usize> {
+        self.kept.iter().position(|&k| k == full)
+    }
+
+    /// First moment c = ∫ρ ū dV = S̄_t0 + S̄ q_f in the beam frame.
+    fn first_moment(&self, f: &DVector<f64>) -> Vector2<f64> {
+        self.st0 + &self.sbar * f
+    }
+
+    /// Mass matrix M(z), written into `m` (ndof × ndof).
+    pub fn mass_matrix(&self, z: &DVector<f64>, mut m: DMatrixViewMut<f64>) {
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf).into_owned();
+        let (ar, ath) = rot(z[THETA]);
+        let c = self.first_moment(&f);
+        let athc = ath * c;
+        let asbar = ar * &self.sbar;
+        let mff_f = &self.mff * &f;
+        let mthf = &self.b + self.w.tr_mul(&f);
+        m.fill(0.0);
+        m[(0, 0)] = self.mass;
+        m[(1, 1)] = self.mass;
+        for i in 0..2 {
+            m[(i, THETA)] = athc[i];
+            m[(THETA, i)] = athc[i];
+            for k in 0..nf {
+                m[(i, FLEX + k)] = asbar[(i, k)];
+                m[(FLEX + k, i)] = asbar[(i, k)];
+            }
+        }
+        m[(THETA, THETA)] = self.i0 + 2.0 * self.a.dot(&f) + f.dot(&mff_f);
+        for k in 0..nf {
+            m[(THETA, FLEX + k)] = mthf[k];
+            m[(FLEX + k, THETA)] = mthf[k];
+        }
+        m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);
+    }
+
+    /// Residual r = M z̈ + h + internal - gravity, added into `r`.
+    pub fn residual(
+        &self,
+        z: &DVector<f64>,
+        zd: &DVector<f64>,
+        zdd: &DVector<f64>,
+        gravity: Vector2<f64>,
+        r: &mut [f64],
+    ) {
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf);
+        let fd = zd.rows(FLEX, nf);
+        let fdd = zdd.rows(FLEX, nf);
+        let (ar, ath) = rot(z[THETA]);
+        let (td, tdd) = (zd[THETA], zdd[THETA]);
+        let rdd = Vector2::new(zdd[0], zdd[1]);
+        let c = self.st0 + &self.sbar * f;
+        let (ac, athc) = (ar * c, ath * c);
+        let sbar_fd = &self.sbar * fd;
+        let sbar_fdd = &self.sbar * fdd;
+        let mff_f = &self.mff * f;
+        let af = &self.a + &mff_f; // ∫ρ Sᵀū dV
+                                   // translation
+        let r_r = rdd * self.mass + athc * tdd + ar * sbar_fdd - ac * (td * td)
+            + ath * sbar_fd * (2.0 * td)
+            - gravity * self.mass;
+        r[0] += r_r[0];
+        r[1] += r_r[1];
+        // rotation
+        let mthth = self.i0 + 2.0 * self.a.dot(&f) + f.dot(&mff_f);
+        let mthf = &self.b + self.w.tr_mul(&f);
+        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf.dot(&fdd) + 2.0 * td * af.dot(&fd)
+            - athc.dot(&gravity);
+        // deformation
+        let rf =
+            self.sbar.tr_mul(&(ar.transpose() * (rdd - gravity))) + &mthf * tdd + &self.mff * fdd
+                - &af * (td * td)
+                - &self.w * fd * (2.0 * td)
+                + &self.kff * f
+                + &self.dff * fd;
+        for k in 0..nf {
+            r[FLEX + k] += rf[k];
+        }
+    }
+
+    /// Tangents of the residual: K_t = ∂r/∂z (at fixed ż, z̈) and C_t = ∂r/∂ż, added into the
+    /// given blocks (ndof × ndof).
+    pub fn tangents(
+        &self,
+        z: &DVector<f64>,
+        zd: &DVector<f64>,
+        zdd: &DVector<f64>,
+        gravity: Vector2<f64>,
+        mut kt: DMatrixViewMut<f64>,
+        mut ct: DMatrixViewMut<f64>,
+    ) {
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf);
+        let fd = zd.rows(FLEX, nf);
+        let fdd = zdd.rows(FLEX, nf);
+        let (ar, ath) = rot(z[THETA]);
+        let (td, tdd) = (zd[THETA], zdd[THETA]);
+        let rdd = Vector2::new(zdd[0], zdd[1]);
+        let c = self.st0 + &self.sbar * f;
+        let (ac, athc) = (ar * c, ath * c);
+        let asbar = ar * &self.sbar;
+        let athsbar = ath * &self.sbar;
+        let af = &self.a + &self.mff * f;
+        // ∂r_R/∂θ, ∂r_R/∂f
+        let d_r_th = -ac * tdd + &athsbar * fdd - athc * (td * td) - &asbar * fd * (2.0 * td);
+        let d_r_f = &athsbar * tdd - &asbar * (td * td);
+        for i in 0..2 {
+            kt[(i, THETA)] += d_r_th[i];
+            for k in 0..nf {
+                kt[(i, FLEX + k)] += d_r_f[(i, k)];
+            }
+        }
+        // ∂r_θ/∂θ, ∂r_θ/∂f
+        kt[(THETA, THETA)] += -ac.dot(&rdd) + ac.dot(&gravity);
+        let d_th_f = athsbar.tr_mul(&(rdd - gravity))
+            + &af * (2.0 * tdd)
+            + &self.w * fdd
+            + &self.mff * fd * (2.0 * td);
+        // ∂r_f/∂θ
+        let d_f_th = athsbar.tr_mul(&(rdd - gravity));
+        for k in 0..nf {
+            kt[(THETA, FLEX + k)] += d_th_f[k];
+            kt[(FLEX + k, THETA)] += d_f_th[k];
+        }
+        // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff
+        for k in 0..nf {
+            for l in 0..nf {
+                kt[(FLEX + k, FLEX + l)] +=
+                    self.w[(l, k)] * tdd - td * td * self.mff[(k, l)] + self.kff[(k, l)];
+            }
+        }
+        // C_t
+        let d_r_thd = -ac * (2.0 * td) + &athsbar * fd * 2.0;
+        for i in 0..2 {
+            ct[(i, THETA)] += d_r_thd[i];
+            for k in 0..nf {
+                ct[(i, FLEX + k)] += 2.0 * td * athsbar[(i, k)];
+            }
+        }
+        ct[(THETA, THETA)] += 2.0 * af.dot(&fd);
+        let d_f_thd = &af * (-2.0 * td) - &self.w * fd * 2.0;
+        for k in 0..nf {
+            ct[(THETA, FLEX + k)] += 2.0 * td * af[k];
+            ct[(FLEX + k, THETA)] += d_f_thd[k];
+            for l in 0..nf {
+                ct[(FLEX + k, FLEX + l)] += -2.0 * td * self.w[(k, l)] + self.dff[(k, l)];
+            }
+        }
+    }
+
+    /// Kinetic energy ½ żᵀ M ż (J).
+    pub fn kinetic_energy(&self, z: &DVector<f64>, zd: &DVector<f64>) -> f64 {
+        let n = self.ndof();
+        let mut m = DMatrix::zeros(n, n);
+        self.mass_matrix(z, m.view_mut((0, 0), (n, n)));
+        0.5 * zd.dot(&(&m * zd))
+    }
+
+    /// Strain energy ½ q_fᵀ K_ff q_f (J).
+    pub fn strain_energy(&self, z: &DVector<f64>) -> f64 {
+        let f = z.rows(FLEX, self.nflex());
+        0.5 * f.dot(&(&self.kff * f))
+    }
+
+    /// Potential energy of gravity -g·∫ρ r dV (J).
+    pub fn gravity_energy(&self, z: &DVector<f64>, gravity: Vector2<f64>) -> f64 {
+        let f = z.rows(FLEX, self.nflex()).into_owned();
+        let (ar, _) = rot(z[THETA]);
+        let com = Vector2::new(z[0], z[1]) * self.mass + ar * self.first_moment(&f);
+        -gravity.dot(&com)
+    }
+
+    /// World position and angle of a material point map, and their Jacobians over z.
+    pub fn point(&self, map: &PointMap, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let f = z.rows(FLEX, self.nflex());
+        let (ar, _) = rot(z[THETA]);
+        let s = map.s0 + &map.sp * f;
+        (
+            Vector2::new(z[0], z[1]) + ar * s,
+            z[THETA] + map.sphi.dot(&f),
+        )
+    }
+
+    /// Position of the map in the beam frame, s = s0 + S_p q_f.
+    pub fn local_point(&self, map: &PointMap, z: &DVector<f64>) -> Vector2<f64> {
+        map.s0 + &map.sp * z.rows(FLEX, self.nflex())
+    }
+
+    /// Static deformation under a transverse tip force, scaled to a tip displacement `tip`
+    /// (tangent frame): the initial shape of case C1.
+    pub fn static_tip_shape(&self, tip: f64) -> Option<DVector<f64>> {
+        let iv = self.flex_index(3 * self.elements + 1)?;
+        let mut load = DVector::zeros(self.nflex());
+        load[iv] = 1.0;
+        let q = self.kff.clone().lu().solve(&load)?;
+        let scale = tip / q[iv];
+        scale.is_finite().then(|| q * scale)
+    }
+}
+
+/// Integrals of eq. (11) over all N elements, before boundary conditions (eq. (8)–(12)).
+fn full_integrals(length: f64, elements: usize, mu: f64, ea: f64, ej: f64) -> FullIntegrals {
+    let n_full = 3 * (elements + 1);
+    let l = length / elements as f64;
+    let mut out = FullIntegrals {
+        sbar: DMatrix::zeros(2, n_full),
+        a: DVector::zeros(n_full),
+        b: DVector::zeros(n_full),
+        mff: DMatrix::zeros(n_full, n_full),
+        w: DMatrix::zeros(n_full, n_full),
+        kff: DMatrix::zeros(n_full, n_full),
+    };
+    let ke = planar_element::stiffness(ea, ej, l);
+    for j in 0..elements {
+        let o = 3 * j; // the connectivity matrix B_j of eq. (9)
+        for &(xi, wgt) in &GAUSS_4 {
+            let (s1, s2) = planar_element::shape(xi, l);
+            let dm = mu * l * wgt;
+            let x0 = (j as f64 + xi) * l;
+            for p in 0..ELEMENT_DOFS {
+                out.sbar[(0, o + p)] += dm * s1[p];
+                out.sbar[(1, o + p)] += dm * s2[p];
+                out.a[o + p] += dm * s1[p] * x0;
+                out.b[o + p] += dm * s2[p] * x0;
+                for q in 0..ELEMENT_DOFS {
+                    out.mff[(o + p, o + q)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
+                    out.w[(o + p, o + q)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
+                }
+            }
+        }
+        for p in 0..ELEMENT_DOFS {
+            for q in 0..ELEMENT_DOFS {
+                out.kff[(o + p, o + q)] += ke[p][q];
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,465 @@
+//! The safe engine behind one FMU instance: a scene, its parameter values, the assembled
+//! system and the integrator state. The FMI layer (`fmi2/`) owns the call-sequence state
+//! machine and hands every request over to these methods.
+
+use crate::error::EngineError;
+use crate::integrator::{self, GaState, Settings, Stats, Stepper};
+use crate::multibody::System;
+use crate::scene::Scene;
+use crate::variables::{
+    Binding, Causality, OutputKind, ParamTarget, VarType, Variability, VariableTable,
+};
+
+/// A built model: the system for the current parameter values and its integration state.
+#[derive(Debug, Clone)]
+struct Model {
+    system: System,
+    state: GaState,
+    stats: Stats,
+    stepper: Stepper,
+}
+
+/// Everything that changes while an instance runs; get/set FMU state copy exactly this.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    initialized: bool,
+    start_time: f64,
+    values: Vec<f64>,
+    state: Option<(GaState, Stats)>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Engine {
+    scene: Scene,
+    table: VariableTable,
+    /// Current value of every parameter, indexed by value reference (outputs unused).
+    values: Vec<f64>,
+    initialized: bool,
+    start_time: f64,
+    model: Option<Model>,
+}
+
+const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
+const STATE_VERSION: u32 = 1;
+
+impl Engine {
+    pub fn new(scene: Scene) -> Engine {
+        let table = VariableTable::build(&scene);
+        let values = table
+            .variables
+            .iter()
+            .map(|v| v.start.unwrap_or(0.0))
+            .collect();
+        Engine {
+            scene,
+            table,
+            values,
+            initialized: false,
+            start_time: 0.0,
+            model: None,
+        }
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn variables(&self) -> &VariableTable {
+        &self.table
+    }
+
+    /// Simulated time of the last accepted communication point.
+    pub fn time(&self) -> f64 {
+        self.model.as_ref().map_or(self.start_time, |m| m.state.t)
+    }
+
+    /// Back to the state right after instantiation: parameters at their start values.
+    pub fn reset(&mut self) {
+        *self = Engine::new(self.scene.clone());
+    }
+
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), EngineError> {
+        self.set(vr, VarType::Real, value)
+    }
+
+    pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), EngineError> {
+        self.set(vr, VarType::Integer, value as f64)
+    }
+
+    pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), EngineError> {
+        self.set(vr, VarType::Boolean, if value { 1.0 } else { 0.0 })
+    }
+
+    pub fn get_real(&mut self, vr: u32) -> Result<f64, EngineError> {
+        self.get(vr, VarType::Real)
+    }
+
+    pub fn get_integer(&mut self, vr: u32) -> Result<i32, EngineError> {
+        Ok(self.get(vr, VarType::Integer)? as i32)
+    }
+
+    pub fn get_boolean(&mut self, vr: u32) -> Result<bool, EngineError> {
+        Ok(self.get(vr, VarType::Boolean)? != 0.0)
+    }
+
+    fn lookup(&self, vr: u32, ty: VarType) -> Result<usize, EngineError> {
+        match self.table.get(vr) {
+            Some(v) if v.ty == ty => Ok(vr as usize),
+            _ => Err(EngineError::UnknownValueReference {
+                vr,
+                ty: ty.as_str(),
+            }),
+        }
+    }
+
+    fn set(&mut self, vr: u32, ty: VarType, value: f64) -> Result<(), EngineError> {
+        let i = self.lookup(vr, ty)?;
+        let var = &self.table.variables[i];
+        let name = var.name.clone();
+        if !value.is_finite() {
+            return Err(EngineError::NonFiniteValue { name, value });
+        }
+        let target = match (var.causality, var.binding) {
+            (Causality::Parameter, Binding::Parameter(t)) => t,
+            _ => {
+                return Err(EngineError::NotSettable {
+                    name,
+                    reason: format!("it is a {} variable", var.causality.as_str()),
+                })
+            }
+        };
+        if self.initialized && var.variability == Variability::Fixed {
+            return Err(EngineError::NotSettable {
+                name,
+                reason: "it is a fixed parameter and the instance is past initialization".into(),
+            });
+        }
+        // The scene's own rules decide what a value may be.
+        let mut trial = self.values.clone();
+        trial[i] = value;
+        let scene = self.scene_with(&trial);
+        if let Err(e) = scene.validate("parameters") {
+            let rule = match e {
+                crate::scene::SceneError::Invalid { rule, .. } => rule,
+                other => other.to_string(),
+            };
+            return Err(EngineError::InvalidValue { name, value, rule });
+        }
+        self.values[i] = value;
+        match &mut self.model {
+            Some(m) if self.initialized => m.stepper.settings = Settings::from_scene(&scene),
+            _ => self.model = None,
+        }
+        let _ = target;
+        Ok(())
+    }
+
+    fn get(&mut self, vr: u32, ty: VarType) -> Result<f64, EngineError> {
+        let i = self.lookup(vr, ty)?;
+        match self.table.variables[i].binding {
+            Binding::Parameter(_) => Ok(self.values[i]),
+            Binding::Output(kind) => {
+                let m = self.built()?;
+                Ok(output(m, kind))
+            }
+        }
+    }
+
+    /// The scene with the given parameter values applied.
+    fn scene_with(&self, values: &[f64]) -> Scene {
+        let mut s = self.scene.clone();
+        for (var, &v) in self.table.variables.iter().zip(values) {
+            if let Binding::Parameter(t) = var.binding {
+                apply(&mut s, t, v);
+            }
+        }
+        s
+    }
+
+    /// The model for the current parameters, built on first need.
+    fn built(&mut self) -> Result<&mut Model, EngineError> {
+        if self.model.is_none() {
+            let scene = self.scene_with(&self.values);
+            scene.validate("parameters")?;
+            let system = System::from_scene(&scene);
+            let settings = Settings::from_scene(&scene);
+            let state = integrator::initial_state(&system, &scene, self.start_time, &settings)?;
+            self.model = Some(Model {
+                stepper: Stepper::new(&system, settings),
+                system,
+                state,
+                stats: Stats::default(),
+            });
+        }
+        Ok(self.model.as_mut().expect("model built above"))
+    }
+
+    /// fmi2SetupExperiment / fmi2EnterInitializationMode: the start time of the run.
+    pub fn set_start_time(&mut self, t0: f64) -> Result<(), EngineError> {
+        if !t0.is_finite() {
+            return Err(EngineError::NonFiniteValue {
+                name: "startTime".into(),
+                value: t0,
+            });
+        }
+        if self.start_time != t0 {
+            self.start_time = t0;
+            self.model = None;
+        }
+        Ok(())
+    }
+
+    /// fmi2ExitInitializationMode: builds the model and fixes the fixed parameters.
+    pub fn exit_initialization(&mut self) -> Result<(), EngineError> {
+        self.built()?;
+        self.initialized = true;
+        Ok(())
+    }
+
+    /// fmi2DoStep: integrates from `t` to `t + h`. On failure the last good state stays.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), EngineError> {
+        if !self.initialized {
+            return Err(EngineError::BadStep {
+                message: "the instance is not initialized".into(),
+            });
+        }
+        if !(h.is_finite() && h > 0.0) {
+            return Err(EngineError::BadStep {
+                message: format!("communicationStepSize = {h} must be positive and finite"),
+            });
+        }
+        let now = self.time();
+        if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
+            return Err(EngineError::BadStep {
+                message: format!(
+                    "currentCommunicationPoint = {t} differs from the instance time {now}"
+                ),
+            });
+        }
+        let m = self.built()?;
+        let saved = (m.state.clone(), m.stats);
+        let result = m
+            .stepper
+            .step_to(&m.system, &mut m.state, &mut m.stats, now + h);
+        if result.is_err() {
+            m.state = saved.0;
+            m.stats = saved.1;
+        }
+        result
+    }
+
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            initialized: self.initialized,
+            start_time: self.start_time,
+            values: self.values.clone(),
+            state: self.model.as_ref().map(|m| (m.state.clone(), m.stats)),
+        }
+    }
+
+    pub fn restore(&mut self, s: &Snapshot) -> Result<(), EngineError> {
+        self.values = s.values.clone();
+        self.start_time = s.start_time;
+        self.model = None;
+        self.initialized = false;
+        if let Some((state, stats)) = &s.state {
+            let m = self.built()?;
+            if state.q.len() != m.state.q.len() || state.lambda.len() != m.state.lambda.len() {
+                return Err(EngineError::BadState {
+                    message: "the state does not belong to this model".into(),
+                });
+            }
+            m.state = state.clone();
+            m.stats = *stats;
+        }
+        self.initialized = s.initialized;
+        Ok(())
+    }
+
+    /// A fingerprint of the scene, so that a state is only restored into the same model.
+    fn fingerprint(&self) -> u64 {
+        // FNV-1a over the canonical scene text.
+        let text = self.scene.to_toml_string();
+        text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+    }
+
+    pub fn serialize(&self, s: &Snapshot) -> Vec<u8> {
+        let mut w = Vec::new();
+        w.extend_from_slice(STATE_MAGIC);
+        w.extend_from_slice(&STATE_VERSION.to_le_bytes());
+        w.extend_from_slice(&self.fingerprint().to_le_bytes());
+        w.push(s.initialized as u8);
+        w.extend_from_slice(&s.start_time.to_le_bytes());
+        put_vec(&mut w, &s.values);
+        match &s.state {
+            None => w.push(0),
+            Some((st, stats)) => {
+                w.push(1);
+                st.write(&mut w);
+                stats.write(&mut w);
+            }
+        }
+        w
+    }
+
+    pub fn deserialize(&self, bytes: &[u8]) -> Result<Snapshot, EngineError> {
+        let mut r = Reader { b: bytes, pos: 0 };
+        let bad = |m: &str| EngineError::BadState {
+            message: m.to_string(),
+        };
+        if r.take(8)? != STATE_MAGIC {
+            return Err(bad(
+                "not a serialized state of this FMU (wrong magic bytes)",
+            ));
+        }
+        if r.u32()? != STATE_VERSION {
+            return Err(bad("serialized state of another format version"));
+        }
+        if r.u64()? != self.fingerprint() {
+            return Err(bad("serialized state of another scene"));
+        }
+        let initialized = match r.u8()? {
+            0 => false,
+            1 => true,
+            _ => return Err(bad("corrupt flag")),
+        };
+        let start_time = r.f64()?;
+        let values = r.vec()?;
+        if values.len() != self.values.len() {
+            return Err(bad("wrong number of parameter values"));
+        }
+        let state = match r.u8()? {
+            0 => None,
+            1 => Some((GaState::read(&mut r)?, Stats::read(&mut r)?)),
+            _ => return Err(bad("corrupt flag")),
+        };
+        if r.pos != bytes.len() {
+            return Err(bad("trailing bytes after the state"));
+        }
+        if values.iter().any(|v| !v.is_finite()) || !start_time.is_finite() {
+            return Err(bad("non-finite values"));
+        }
+        Ok(Snapshot {
+            initialized,
+            start_time,
+            values,
+            state,
+        })
+    }
+}
+
+fn apply(s: &mut Scene, t: ParamTarget, v: f64) {
+    use ParamTarget as T;
+    match t {
+        T::GravityX => s.world.gravity[0] = v,
+        T::GravityY => s.world.gravity[1] = v,
+        T::SolverAdaptive => s.solver.adaptive = v != 0.0,
+        T::SolverTolerance => s.solver.tolerance = v,
+        T::SolverMaxStep => s.solver.max_step = v,
+        T::SolverRhoInf => s.solver.rho_inf = v,
+        T::BeamLength(i) => s.beams[i].length = v,
+        T::BeamRho(i) => s.beams[i].material.rho = v,
+        T::BeamE(i) => s.beams[i].material.e = v,
+        T::BeamArea(i) => s.beams[i].section.area = Some(v),
+        T::BeamSecondMoment(i) => s.beams[i].section.second_moment = Some(v),
+        T::BeamRayleighAlpha(i) => s.beams[i].rayleigh.alpha = v,
+        T::BeamRayleighBeta(i) => s.beams[i].rayleigh.beta = v,
+        T::BeamTipDisplacement(i) => s.beams[i].initial.tip_displacement = v,
+    }
+}
+
+fn output(m: &Model, kind: OutputKind) -> f64 {
+    use OutputKind as K;
+    let sys = &m.system;
+    let (q, v) = (&m.state.q, &m.state.v);
+    let tip = |i: usize| {
+        let b = &sys.bodies[i];
+        let z = sys.body_coords(i, q);
+        (b, z)
+    };
+    match kind {
+        K::TipDeflection(i) => {
+            let (b, z) = tip(i);
+            b.local_point(&b.flange_b, &z)[1]
+        }
+        K::TipX(i) => {
+            let (b, z) = tip(i);
+            b.point(&b.flange_b, &z).0[0]
+        }
+        K::TipY(i) => {
+            let (b, z) = tip(i);
+            b.point(&b.flange_b, &z).0[1]
+        }
+        K::TipPhi(i) => {
+            let (b, z) = tip(i);
+            b.point(&b.flange_b, &z).1
+        }
+        K::SectionArea(i) => sys.bodies[i].section.area,
+        K::SectionSecondMoment(i) => sys.bodies[i].section.second_moment,
+        K::EnergyKinetic => sys.energy(q, v).kinetic,
+        K::EnergyStrain => sys.energy(q, v).strain,
+        K::EnergyPotential => sys.energy(q, v).potential,
+        K::EnergyTotal => sys.energy(q, v).total(),
+        K::SolverSteps => m.stats.steps as f64,
+        K::SolverNewtonIterations => m.stats.newton_iterations as f64,
+        K::SolverJacobians => m.stats.jacobians as f64,
+        K::SolverRejectedSteps => m.stats.rejected as f64,
+    }
+}
+
+fn put_vec(w: &mut Vec<u8>, v: &[f64]) {
+    w.extend_from_slice(&(v.len() as u64).to_le_bytes());
+    for x in v {
+        w.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+/// Bounds-checked reader of serialized states.
+pub(crate) struct Reader<'a> {
+    b: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], EngineError> {
+        if self.b.len() - self.pos < n {
+            return Err(EngineError::BadState {
+                message: format!("truncated: {} bytes, more expected", self.b.len()),
+            });
+        }
+        let s = &self.b[self.pos..self.pos + n];
+        self.pos += n;
+        Ok(s)
+    }
+    pub(crate) fn u8(&mut self) -> Result<u8, EngineError> {
+        Ok(self.take(1)?[0])
+    }
+    pub(crate) fn u32(&mut self) -> Result<u32, EngineError> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().unwrap_or_default(),
+        ))
+    }
+    pub(crate) fn u64(&mut self) -> Result<u64, EngineError> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
+    }
+    pub(crate) fn f64(&mut self) -> Result<f64, EngineError> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    pub(crate) fn vec(&mut self) -> Result<Vec<f64>, EngineError> {
+        let n = self.u64()? as usize;
+        if n > (self.b.len() - self.pos) / 8 {
+            return Err(EngineError::BadState {
+                message: format!("a vector of {n} values does not fit in the bytes left"),
+            });
+        }
+        (0..n).map(|_| self.f64()).collect()
+    }
+}
+
+pub(crate) fn write_vec(w: &mut Vec<u8>, v: &[f64]) {
+    put_vec(w, v)
+}

@@ -1,0 +1,138 @@
+//! Consistent initial conditions: assemble the mechanism (g(q) = 0), then solve for the
+//! accelerations and multipliers that the equations of motion give at rest.
+
+use super::{GaState, Settings};
+use crate::error::EngineError;
+use crate::multibody::System;
+use crate::scene::Scene;
+use nalgebra::{DMatrix, DVector};
+
+const ASSEMBLY_ITERATIONS: usize = 50;
+
+/// Builds the state at `t0` from the scene's initial configuration.
+pub fn initial_state(
+    sys: &System,
+    scene: &Scene,
+    t0: f64,
+    settings: &Settings,
+) -> Result<GaState, EngineError> {
+    let (n, m) = (sys.n(), sys.m());
+    let mut q = sys.initial_coordinates(scene)?;
+    let v = DVector::zeros(n);
+    let length = sys.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
+    let tol = 1e-12 * length.max(1.0);
+    let mut g = DVector::zeros(m);
+    let mut gm = DMatrix::zeros(m, n);
+    if m > 0 {
+        sys.constraint_jacobian(&q, &mut gm);
+        check_rank(sys, &gm, t0)?;
+        let mut iterations = 0;
+        loop {
+            sys.constraints(&q, &mut g);
+            let residual = g.amax();
+            if residual <= tol {
+                break;
+            }
+            if iterations == ASSEMBLY_ITERATIONS || !residual.is_finite() {
+                let rows: Vec<usize> = (0..m).filter(|&i| g[i].abs() > tol).collect();
+                return Err(EngineError::Assembly {
+                    t: t0,
+                    residual,
+                    joints: sys.joints_of_rows(&rows).join(", "),
+                    tolerance: tol,
+                    iterations,
+                });
+            }
+            sys.constraint_jacobian(&q, &mut gm);
+            // minimum-norm correction Δq = -Gᵀ (G Gᵀ)⁻¹ g
+            let ggt = &gm * gm.transpose();
+            let y = ggt.lu().solve(&g).ok_or_else(|| EngineError::Assembly {
+                t: t0,
+                residual,
+                joints: sys.joints_of_rows(&(0..m).collect::<Vec<_>>()).join(", "),
+                tolerance: tol,
+                iterations,
+            })?;
+            q -= gm.transpose() * y;
+            iterations += 1;
+        }
+    }
+    let (qdd, lambda) = consistent_accelerations(sys, &q, &v, t0)?;
+    let h = if settings.adaptive {
+        settings.max_step.min(1e-3)
+    } else {
+        settings.max_step
+    };
+    Ok(GaState {
+        t: t0,
+        h,
+        acc: qdd.clone(),
+        qdd,
+        lambda,
+        q,
+        v,
+    })
+}
+
+/// Refuses redundant joints: G must have full row rank.
+fn check_rank(sys: &System, gm: &DMatrix<f64>, t: f64) -> Result<(), EngineError> {
+    let m = gm.nrows();
+    let svd = gm.transpose().svd(false, true);
+    let smax = svd.singular_values.amax();
+    let weak: Vec<usize> = match &svd.v_t {
+        Some(vt) => (0..m)
+            .filter(|&k| svd.singular_values[k] <= 1e-10 * smax.max(1e-300))
+            .flat_map(|k| {
+                let row = vt.row(k).into_owned();
+                (0..m).filter(move |&i| row[i].abs() > 1e-6)
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    if weak.is_empty() {
+        return Ok(());
+    }
+    Err(EngineError::InitialState {
+        message: format!(
+            "redundant constraints at t = {t} s: joint(s) {} fix the same motion twice; \
+             remove one or free a direction",
+            sys.joints_of_rows(&weak).join(", ")
+        ),
+    })
+}
+
+/// Solves [[M, Gᵀ], [G, 0]] [q''; λ] = [-r(q, q', 0); -bias].
+pub fn consistent_accelerations(
+    sys: &System,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    t: f64,
+) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
+    let (n, m) = (sys.n(), sys.m());
+    let mut mm = DMatrix::zeros(n, n);
+    sys.mass_matrix(q, &mut mm);
+    let mut gm = DMatrix::zeros(m, n);
+    sys.constraint_jacobian(q, &mut gm);
+    let mut r = DVector::zeros(n);
+    sys.body_residual(q, v, &DVector::zeros(n), &mut r);
+    let mut bias = DVector::zeros(m);
+    sys.accel_bias(q, v, &mut bias);
+    let mut a = DMatrix::zeros(n + m, n + m);
+    a.view_mut((0, 0), (n, n)).copy_from(&mm);
+    a.view_mut((0, n), (n, m)).copy_from(&gm.transpose());
+    a.view_mut((n, 0), (m, n)).copy_from(&gm);
+    let mut rhs = DVector::zeros(n + m);
+    rhs.rows_mut(0, n).copy_from(&(-r));
+    rhs.rows_mut(n, m).copy_from(&(-bias));
+    let x = a
+        .lu()
+        .solve(&rhs)
+        .filter(|x| x.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| EngineError::InitialState {
+            message: format!(
+                "the mass matrix is singular at t = {t} s on motions the joints leave free \
+                 (a body without mass or inertia that nothing holds)"
+            ),
+        })?;
+    Ok((x.rows(0, n).into_owned(), x.rows(n, m).into_owned()))
+}

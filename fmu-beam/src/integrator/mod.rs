@@ -1,0 +1,106 @@
+//! Time integration of M(q) q'' + G(q)ᵀλ = Q(q, q', t), g(q) = 0.
+
+pub mod generalized_alpha;
+pub mod initial;
+
+pub use generalized_alpha::{GaState, Stepper};
+pub use initial::initial_state;
+
+use crate::engine::{write_vec, Reader};
+use crate::error::EngineError;
+use crate::scene::Scene;
+
+/// Solver settings (all tunable between communication steps).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    pub adaptive: bool,
+    pub tolerance: f64,
+    pub max_step: f64,
+    pub rho_inf: f64,
+}
+
+impl Settings {
+    pub fn from_scene(scene: &Scene) -> Settings {
+        Settings {
+            adaptive: scene.solver.adaptive,
+            tolerance: scene.solver.tolerance,
+            max_step: scene.solver.max_step,
+            rho_inf: scene.solver.rho_inf,
+        }
+    }
+}
+
+/// Work counters since initialization.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Stats {
+    pub steps: u64,
+    pub newton_iterations: u64,
+    pub jacobians: u64,
+    pub rejected: u64,
+}
+
+impl Stats {
+    pub(crate) fn write(&self, w: &mut Vec<u8>) {
+        for x in [
+            self.steps,
+            self.newton_iterations,
+            self.jacobians,
+            self.rejected,
+        ] {
+            w.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+
+    pub(crate) fn read(r: &mut Reader) -> Result<Stats, EngineError> {
+        Ok(Stats {
+            steps: r.u64()?,
+            newton_iterations: r.u64()?,
+            jacobians: r.u64()?,
+            rejected: r.u64()?,
+        })
+    }
+}
+
+impl GaState {
+    pub(crate) fn write(&self, w: &mut Vec<u8>) {
+        w.extend_from_slice(&self.t.to_le_bytes());
+        w.extend_from_slice(&self.h.to_le_bytes());
+        for v in [&self.q, &self.v, &self.acc, &self.qdd, &self.lambda] {
+            write_vec(w, v.as_slice());
+        }
+    }
+
+    pub(crate) fn read(r: &mut Reader) -> Result<GaState, EngineError> {
+        let t = r.f64()?;
+        let h = r.f64()?;
+        let mut vs = Vec::with_capacity(5);
+        for _ in 0..5 {
+            vs.push(nalgebra::DVector::from_vec(r.vec()?));
+        }
+        let n = vs[0].len();
+        if vs[1..4].iter().any(|v| v.len() != n) {
+            return Err(EngineError::BadState {
+                message: "state vectors of different lengths".into(),
+            });
+        }
+        if !t.is_finite() || !h.is_finite() || vs.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
+            return Err(EngineError::BadState {
+                message: "non-finite numbers in the state".into(),
+            });
+        }
+        let lambda = vs.pop().unwrap_or_default();
+        let qdd = vs.pop().unwrap_or_default();
+        let acc = vs.pop().unwrap_or_default();
+        let v = vs.pop().unwrap_or_default();
+        let q = vs.pop().unwrap_or_default();
+        Ok(GaState {
+            t,
+            h,
+            q,
+            v,
+            acc,
+            qdd,
+            lambda,
+        })
+    }
+}

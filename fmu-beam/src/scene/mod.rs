@@ -1,0 +1,270 @@
+//! The scene file: what a user writes (TOML, read with serde), and its validation.
+//!
+//! A scene names its beams, the joints that hold them, the solver settings and the default
+//! experiment. Unknown keys are refused by serde (`deny_unknown_fields`); every value rule is
+//! checked in [`validate`], whose errors name the field and the rule.
+
+mod validate;
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub use validate::SceneError;
+
+/// A whole scene, as read from its TOML file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Model name; the packager derives the modelIdentifier from it.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub world: World,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub experiment: ExperimentSpec,
+    #[serde(default, rename = "beam")]
+    pub beams: Vec<BeamSpec>,
+    #[serde(default, rename = "joint")]
+    pub joints: Vec<JointSpec>,
+}
+
+/// The world: its gravity field (m/s^2, world axes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct World {
+    #[serde(default)]
+    pub gravity: [f64; 2],
+}
+
+/// Integrator settings; each becomes a tunable FMU parameter `solver.<field>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Local error control on (true) or a fixed internal step of `max_step` (false).
+    #[serde(default = "default_adaptive")]
+    pub adaptive: bool,
+    /// Relative tolerance of the error control and of the Newton iteration.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Largest internal step (s); the fixed step when `adaptive = false`.
+    #[serde(default = "default_max_step")]
+    pub max_step: f64,
+    /// Spectral radius at infinity of generalized-alpha: 1 = no numerical damping.
+    #[serde(default = "default_rho_inf")]
+    pub rho_inf: f64,
+}
+
+fn default_adaptive() -> bool {
+    true
+}
+fn default_tolerance() -> f64 {
+    1e-6
+}
+fn default_max_step() -> f64 {
+    1e-2
+}
+fn default_rho_inf() -> f64 {
+    0.9
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            adaptive: default_adaptive(),
+            tolerance: default_tolerance(),
+            max_step: default_max_step(),
+            rho_inf: default_rho_inf(),
+        }
+    }
+}
+
+/// The DefaultExperiment written into modelDescription.xml.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentSpec {
+    #[serde(default)]
+    pub start_time: f64,
+    #[serde(default = "default_stop_time")]
+    pub stop_time: f64,
+    /// Communication step (s).
+    #[serde(default = "default_step_size")]
+    pub step_size: f64,
+}
+
+fn default_stop_time() -> f64 {
+    1.0
+}
+fn default_step_size() -> f64 {
+    1e-3
+}
+
+impl Default for ExperimentSpec {
+    fn default() -> Self {
+        ExperimentSpec {
+            start_time: 0.0,
+            stop_time: default_stop_time(),
+            step_size: default_step_size(),
+        }
+    }
+}
+
+/// A flexible planar beam (planar paper §3): Euler–Bernoulli elements in one floating frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamSpec {
+    pub name: String,
+    /// Undeformed length (m).
+    pub length: f64,
+    /// Number of finite elements N.
+    pub elements: usize,
+    /// Reference frame of the deformation field (planar paper §3.3).
+    #[serde(default)]
+    pub frame: FrameKind,
+    pub material: MaterialSpec,
+    pub section: SectionSpec,
+    #[serde(default)]
+    pub rayleigh: RayleighSpec,
+    /// World position of flange a (m) in the undeformed initial configuration.
+    #[serde(default)]
+    pub position: [f64; 2],
+    /// World angle of the beam axis (rad) in the initial configuration.
+    #[serde(default)]
+    pub angle: f64,
+    #[serde(default)]
+    pub initial: InitialSpec,
+    /// Outputs to offer; empty means all of [`BEAM_OUTPUTS`].
+    #[serde(default)]
+    pub outputs: Vec<String>,
+}
+
+/// The outputs a beam can offer, by their name after `<beam>.`.
+pub const BEAM_OUTPUTS: [&str; 4] = ["tip.deflection", "tip.x", "tip.y", "tip.phi"];
+
+/// Reference frame conventions of the planar paper §3.3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FrameKind {
+    /// Frame tangent to the beam at flange a: root deformation (u, v, slope) is zero.
+    #[default]
+    Tangent,
+    /// Frame through both ends: root (u, v) and tip v are zero.
+    Pinned,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Density (kg/m^3).
+    pub rho: f64,
+    /// Young's modulus (Pa).
+    #[serde(rename = "E")]
+    pub e: f64,
+    /// Shear modulus (Pa); used by 3D beams only.
+    #[serde(rename = "G", default)]
+    pub g: Option<f64>,
+}
+
+/// A cross-section: either `A` and `J` given directly, or a `shape` with its dimensions.
+/// For the planar beam, `a` is the height in the plane of bending, `b` the width.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SectionSpec {
+    /// Area (m^2), given directly.
+    #[serde(rename = "A", default)]
+    pub area: Option<f64>,
+    /// Second moment of area for in-plane bending (m^4), given directly.
+    #[serde(rename = "J", default)]
+    pub second_moment: Option<f64>,
+    /// `rectangle`, `circle`, `hollow_rectangle`, `hollow_circle`.
+    #[serde(default)]
+    pub shape: Option<String>,
+    #[serde(default)]
+    pub a: Option<f64>,
+    #[serde(default)]
+    pub b: Option<f64>,
+    #[serde(default)]
+    pub d: Option<f64>,
+    /// Wall thickness of a hollow shape (m).
+    #[serde(default)]
+    pub t: Option<f64>,
+}
+
+/// Rayleigh damping D = alpha m_ff + beta K_ff.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RayleighSpec {
+    #[serde(default)]
+    pub alpha: f64,
+    #[serde(default)]
+    pub beta: f64,
+}
+
+/// Initial deformed state of a beam, at rest.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Transverse tip displacement (m) of the static shape under a tip force (tangent frame).
+    #[serde(default)]
+    pub tip_displacement: f64,
+}
+
+/// A joint between two frames, named `world` or `<beam>.a` / `<beam>.b`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: JointKind,
+    /// The two frames the joint connects.
+    pub frames: [String; 2],
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// Rigid connection: position and angle of the two frames coincide.
+    Weld,
+}
+
+impl Scene {
+    /// Parses and validates scene text; `origin` (a file name) prefixes every message.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        scene.validate(origin)?;
+        Ok(scene)
+    }
+
+    /// Reads, parses and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+            origin: origin.clone(),
+            message: e.to_string(),
+        })?;
+        Scene::from_toml_str(&text, &origin)
+    }
+
+    /// The canonical TOML text of this scene (what the packager writes into the FMU).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    pub fn beam(&self, name: &str) -> Option<&BeamSpec> {
+        self.beams.iter().find(|b| b.name == name)
+    }
+
+    /// The outputs of a beam, resolved (an empty list means all).
+    pub fn beam_outputs(beam: &BeamSpec) -> Vec<&'static str> {
+        BEAM_OUTPUTS
+            .iter()
+            .copied()
+            .filter(|o| beam.outputs.is_empty() || beam.outputs.iter().any(|x| x == o))
+            .collect()
+    }
+}

@@ -1,0 +1,308 @@
+//! Value rules of a scene. Each error names the file, the field and the rule.
+
+use super::{BeamSpec, FrameKind, Scene, SectionSpec, BEAM_OUTPUTS};
+use thiserror::Error;
+
+/// Why a scene was refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SceneError {
+    #[error("{origin}: cannot read the scene: {message}")]
+    Io { origin: String, message: String },
+    #[error("{origin}: {message}")]
+    Parse { origin: String, message: String },
+    #[error("{origin}: field `{field}` = {value}: {rule}")]
+    Invalid {
+        origin: String,
+        field: String,
+        value: String,
+        rule: String,
+    },
+}
+
+struct Checker<'a> {
+    origin: &'a str,
+}
+
+impl Checker<'_> {
+    fn fail(&self, field: &str, value: impl std::fmt::Display, rule: &str) -> SceneError {
+        SceneError::Invalid {
+            origin: self.origin.to_string(),
+            field: field.to_string(),
+            value: value.to_string(),
+            rule: rule.to_string(),
+        }
+    }
+
+    fn finite(&self, field: &str, v: f64) -> Result<(), SceneError> {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(self.fail(field, v, "must be a finite number"))
+        }
+    }
+
+    fn positive(&self, field: &str, v: f64) -> Result<(), SceneError> {
+        self.finite(field, v)?;
+        if v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(field, v, "must be positive"))
+        }
+    }
+
+    fn non_negative(&self, field: &str, v: f64) -> Result<(), SceneError> {
+        self.finite(field, v)?;
+        if v >= 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(field, v, "must not be negative"))
+        }
+    }
+}
+
+/// Characters allowed in names that become parts of FMI variable names.
+fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+impl Scene {
+    pub(crate) fn validate(&self, origin: &str) -> Result<(), SceneError> {
+        let ck = Checker { origin };
+        if !is_identifier(&self.name) {
+            return Err(ck.fail(
+                "name",
+                format!("{:?}", self.name),
+                "must be an identifier (letters, digits, _; not starting with a digit)",
+            ));
+        }
+        for (i, g) in self.world.gravity.iter().enumerate() {
+            ck.finite(&format!("world.gravity[{i}]"), *g)?;
+        }
+        let s = &self.solver;
+        ck.positive("solver.tolerance", s.tolerance)?;
+        if s.tolerance >= 1.0 {
+            return Err(ck.fail("solver.tolerance", s.tolerance, "must be below 1"));
+        }
+        ck.positive("solver.max_step", s.max_step)?;
+        ck.finite("solver.rho_inf", s.rho_inf)?;
+        if !(0.0..=1.0).contains(&s.rho_inf) {
+            return Err(ck.fail("solver.rho_inf", s.rho_inf, "must lie in [0, 1]"));
+        }
+        let e = &self.experiment;
+        ck.finite("experiment.start_time", e.start_time)?;
+        ck.finite("experiment.stop_time", e.stop_time)?;
+        if e.stop_time <= e.start_time {
+            return Err(ck.fail(
+                "experiment.stop_time",
+                e.stop_time,
+                "must be after experiment.start_time",
+            ));
+        }
+        ck.positive("experiment.step_size", e.step_size)?;
+
+        if self.beams.is_empty() {
+            return Err(ck.fail("beam", "[]", "a scene needs at least one [[beam]]"));
+        }
+        for (i, b) in self.beams.iter().enumerate() {
+            validate_beam(&ck, b, i)?;
+            if self.beams[..i].iter().any(|o| o.name == b.name) {
+                return Err(ck.fail(
+                    &format!("beam[{i}].name"),
+                    format!("{:?}", b.name),
+                    "beam names must be unique",
+                ));
+            }
+        }
+        for (i, j) in self.joints.iter().enumerate() {
+            let field = format!("joint[{i}]");
+            if !is_identifier(&j.name) {
+                return Err(ck.fail(
+                    &format!("{field}.name"),
+                    format!("{:?}", j.name),
+                    "must be an identifier (letters, digits, _; not starting with a digit)",
+                ));
+            }
+            if self.beams.iter().any(|b| b.name == j.name)
+                || self.joints[..i].iter().any(|o| o.name == j.name)
+            {
+                return Err(ck.fail(
+                    &format!("{field}.name"),
+                    format!("{:?}", j.name),
+                    "names of beams and joints must be unique",
+                ));
+            }
+            for (k, f) in j.frames.iter().enumerate() {
+                if !self.frame_exists(f) {
+                    return Err(ck.fail(
+                        &format!("{field}.frames[{k}]"),
+                        format!("{f:?}"),
+                        "must be `world` or `<beam>.a` / `<beam>.b` of a beam in this scene",
+                    ));
+                }
+            }
+            if j.frames[0] == j.frames[1] {
+                return Err(ck.fail(
+                    &format!("{field}.frames"),
+                    format!("{:?}", j.frames),
+                    "a joint connects two different frames",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn frame_exists(&self, frame: &str) -> bool {
+        if frame == "world" {
+            return true;
+        }
+        match frame.rsplit_once('.') {
+            Some((beam, "a" | "b")) => self.beams.iter().any(|b| b.name == beam),
+            _ => false,
+        }
+    }
+}
+
+fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError> {
+    let f = |name: &str| format!("beam[{i}].{name}");
+    if !is_identifier(&b.name) {
+        return Err(ck.fail(
+            &f("name"),
+            format!("{:?}", b.name),
+            "must be an identifier (letters, digits, _; not starting with a digit)",
+        ));
+    }
+    ck.positive(&f("length"), b.length)?;
+    if b.elements == 0 {
+        return Err(ck.fail(&f("elements"), b.elements, "must be at least 1"));
+    }
+    if b.elements > 2000 {
+        return Err(ck.fail(&f("elements"), b.elements, "must be at most 2000"));
+    }
+    ck.positive(&f("material.rho"), b.material.rho)?;
+    ck.positive(&f("material.E"), b.material.e)?;
+    if let Some(g) = b.material.g {
+        ck.positive(&f("material.G"), g)?;
+    }
+    validate_section(ck, &b.section, &f("section"))?;
+    ck.non_negative(&f("rayleigh.alpha"), b.rayleigh.alpha)?;
+    ck.non_negative(&f("rayleigh.beta"), b.rayleigh.beta)?;
+    for (k, p) in b.position.iter().enumerate() {
+        ck.finite(&f(&format!("position[{k}]")), *p)?;
+    }
+    ck.finite(&f("angle"), b.angle)?;
+    ck.finite(&f("initial.tip_displacement"), b.initial.tip_displacement)?;
+    if b.initial.tip_displacement.abs() > 0.5 * b.length {
+        return Err(ck.fail(
+            &f("initial.tip_displacement"),
+            b.initial.tip_displacement,
+            "must be small against the length (at most half of it)",
+        ));
+    }
+    if b.initial.tip_displacement != 0.0 && b.frame == FrameKind::Pinned {
+        return Err(ck.fail(
+            &f("initial.tip_displacement"),
+            b.initial.tip_displacement,
+            "needs frame = \"tangent\" (a pinned frame holds the tip on its axis)",
+        ));
+    }
+    for (k, o) in b.outputs.iter().enumerate() {
+        if !BEAM_OUTPUTS.contains(&o.as_str()) {
+            return Err(ck.fail(
+                &f(&format!("outputs[{k}]")),
+                format!("{o:?}"),
+                &format!("must be one of {BEAM_OUTPUTS:?}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{field}.{name}");
+    let given = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
+        match v {
+            Some(x) => {
+                ck.positive(&f(name), x)?;
+                Ok(x)
+            }
+            None => Err(ck.fail(&f(name), "missing", "is required for this section")),
+        }
+    };
+    let unused = |v: Option<f64>, name: &str, why: &str| -> Result<(), SceneError> {
+        match v {
+            Some(x) => Err(ck.fail(&f(name), x, why)),
+            None => Ok(()),
+        }
+    };
+    match s.shape.as_deref() {
+        None => {
+            if s.area.is_none() && s.second_moment.is_none() {
+                return Err(ck.fail(
+                    field,
+                    "missing",
+                    "give `A` and `J`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
+                ));
+            }
+            given(s.area, "A")?;
+            given(s.second_moment, "J")?;
+            for (v, n) in [(s.a, "a"), (s.b, "b"), (s.d, "d"), (s.t, "t")] {
+                unused(
+                    v,
+                    n,
+                    "belongs to a `shape`; with `A` and `J` given it is not used",
+                )?;
+            }
+        }
+        Some(shape) => {
+            for (v, n) in [(s.area, "A"), (s.second_moment, "J")] {
+                unused(
+                    v,
+                    n,
+                    "is computed from the `shape`; give either the shape or A and J",
+                )?;
+            }
+            match shape {
+                "rectangle" => {
+                    given(s.a, "a")?;
+                    given(s.b, "b")?;
+                    unused(s.d, "d", "is not a dimension of a rectangle")?;
+                    unused(s.t, "t", "is for hollow shapes")?;
+                }
+                "hollow_rectangle" => {
+                    let a = given(s.a, "a")?;
+                    let b = given(s.b, "b")?;
+                    let t = given(s.t, "t")?;
+                    unused(s.d, "d", "is not a dimension of a rectangle")?;
+                    if 2.0 * t >= a.min(b) {
+                        return Err(ck.fail(&f("t"), t, "must be less than half of min(a, b)"));
+                    }
+                }
+                "circle" => {
+                    given(s.d, "d")?;
+                    unused(s.a, "a", "is not a dimension of a circle")?;
+                    unused(s.b, "b", "is not a dimension of a circle")?;
+                    unused(s.t, "t", "is for hollow shapes")?;
+                }
+                "hollow_circle" => {
+                    let d = given(s.d, "d")?;
+                    let t = given(s.t, "t")?;
+                    unused(s.a, "a", "is not a dimension of a circle")?;
+                    unused(s.b, "b", "is not a dimension of a circle")?;
+                    if 2.0 * t >= d {
+                        return Err(ck.fail(&f("t"), t, "must be less than half of d"));
+                    }
+                }
+                other => {
+                    return Err(ck.fail(
+                        &f("shape"),
+                        format!("{other:?}"),
+                        "must be one of rectangle, circle, hollow_rectangle, hollow_circle",
+                    ))
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,545 @@
+//! The variable table of a scene: the single source of the engine's get/set and of the
+//! ModelVariables, UnitDefinitions and ModelStructure that the packager writes.
+
+use crate::scene::Scene;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+impl VarType {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+}
+
+impl Causality {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Causality::Parameter => "parameter",
+            Causality::CalculatedParameter => "calculatedParameter",
+            Causality::Input => "input",
+            Causality::Output => "output",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variability {
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+impl Variability {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Variability::Fixed => "fixed",
+            Variability::Tunable => "tunable",
+            Variability::Discrete => "discrete",
+            Variability::Continuous => "continuous",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Initial {
+    Exact,
+    Calculated,
+}
+
+impl Initial {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Initial::Exact => "exact",
+            Initial::Calculated => "calculated",
+        }
+    }
+}
+
+/// What a parameter changes in the scene before the model is built (or, when tunable, in the
+/// running solver).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamTarget {
+    GravityX,
+    GravityY,
+    SolverAdaptive,
+    SolverTolerance,
+    SolverMaxStep,
+    SolverRhoInf,
+    BeamLength(usize),
+    BeamRho(usize),
+    BeamE(usize),
+    BeamArea(usize),
+    BeamSecondMoment(usize),
+    BeamRayleighAlpha(usize),
+    BeamRayleighBeta(usize),
+    BeamTipDisplacement(usize),
+}
+
+/// What an output or calculated parameter reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputKind {
+    /// Transverse displacement of flange b in the beam frame (m).
+    TipDeflection(usize),
+    TipX(usize),
+    TipY(usize),
+    TipPhi(usize),
+    /// Calculated section constants of a beam whose section is a shape.
+    SectionArea(usize),
+    SectionSecondMoment(usize),
+    EnergyKinetic,
+    EnergyStrain,
+    EnergyPotential,
+    EnergyTotal,
+    SolverSteps,
+    SolverNewtonIterations,
+    SolverJacobians,
+    SolverRejectedSteps,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    Parameter(ParamTarget),
+    Output(OutputKind),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub vr: u32,
+    pub ty: VarType,
+    pub causality: Causality,
+    pub variability: Variability,
+    pub initial: Option<Initial>,
+    pub unit: Option<&'static str>,
+    pub description: String,
+    /// Start value of parameters (Booleans as 0/1).
+    pub start: Option<f64>,
+    pub binding: Binding,
+}
+
+/// A unit in SI base-unit exponents, for UnitDefinitions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UnitDef {
+    pub name: &'static str,
+    pub kg: i32,
+    pub m: i32,
+    pub s: i32,
+    pub rad: i32,
+}
+
+/// Every unit a variable may use.
+pub const UNITS: &[UnitDef] = &[
+    UnitDef {
+        name: "m",
+        kg: 0,
+        m: 1,
+        s: 0,
+        rad: 0,
+    },
+    UnitDef {
+        name: "rad",
+        kg: 0,
+        m: 0,
+        s: 0,
+        rad: 1,
+    },
+    UnitDef {
+        name: "s",
+        kg: 0,
+        m: 0,
+        s: 1,
+        rad: 0,
+    },
+    UnitDef {
+        name: "m/s2",
+        kg: 0,
+        m: 1,
+        s: -2,
+        rad: 0,
+    },
+    UnitDef {
+        name: "kg/m3",
+        kg: 1,
+        m: -3,
+        s: 0,
+        rad: 0,
+    },
+    UnitDef {
+        name: "Pa",
+        kg: 1,
+        m: -1,
+        s: -2,
+        rad: 0,
+    },
+    UnitDef {
+        name: "m2",
+        kg: 0,
+        m: 2,
+        s: 0,
+        rad: 0,
+    },
+    UnitDef {
+        name: "m4",
+        kg: 0,
+        m: 4,
+        s: 0,
+        rad: 0,
+    },
+    UnitDef {
+        name: "J",
+        kg: 1,
+        m: 2,
+        s: -2,
+        rad: 0,
+    },
+    UnitDef {
+        name: "1/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        rad: 0,
+    },
+];
+
+/// All variables of a scene, in value-reference order (vr = index; unique over all types).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VariableTable {
+    pub variables: Vec<Variable>,
+}
+
+impl VariableTable {
+    pub fn build(scene: &Scene) -> VariableTable {
+        let mut t = Builder { vars: Vec::new() };
+        use Binding::{Output as O, Parameter as P};
+        use Causality as C;
+        use OutputKind as K;
+        use ParamTarget as T;
+        use Variability as V;
+        let real_param = |t: &mut Builder, name: String, target, unit, v: f64, var, desc: &str| {
+            t.push(
+                name,
+                VarType::Real,
+                C::Parameter,
+                var,
+                Some(unit),
+                desc,
+                Some(v),
+                P(target),
+            );
+        };
+        let g = scene.world.gravity;
+        real_param(
+            &mut t,
+            "world.gravity.x".into(),
+            T::GravityX,
+            "m/s2",
+            g[0],
+            V::Fixed,
+            "Gravity, world x",
+        );
+        real_param(
+            &mut t,
+            "world.gravity.y".into(),
+            T::GravityY,
+            "m/s2",
+            g[1],
+            V::Fixed,
+            "Gravity, world y",
+        );
+        let s = &scene.solver;
+        t.push(
+            "solver.adaptive".into(),
+            VarType::Boolean,
+            C::Parameter,
+            V::Tunable,
+            None,
+            "Local error control (true) or a fixed internal step of solver.max_step (false)",
+            Some(if s.adaptive { 1.0 } else { 0.0 }),
+            P(T::SolverAdaptive),
+        );
+        real_param(
+            &mut t,
+            "solver.tolerance".into(),
+            T::SolverTolerance,
+            "1",
+            s.tolerance,
+            V::Tunable,
+            "Relative tolerance of the error control and of the Newton iteration",
+        );
+        real_param(
+            &mut t,
+            "solver.max_step".into(),
+            T::SolverMaxStep,
+            "s",
+            s.max_step,
+            V::Tunable,
+            "Largest internal step; the fixed step when solver.adaptive is false",
+        );
+        real_param(
+            &mut t,
+            "solver.rho_inf".into(),
+            T::SolverRhoInf,
+            "1",
+            s.rho_inf,
+            V::Tunable,
+            "Generalized-alpha spectral radius at infinity (1: no numerical damping)",
+        );
+        for (i, b) in scene.beams.iter().enumerate() {
+            let n = &b.name;
+            real_param(
+                &mut t,
+                format!("{n}.length"),
+                T::BeamLength(i),
+                "m",
+                b.length,
+                V::Fixed,
+                "Undeformed length",
+            );
+            real_param(
+                &mut t,
+                format!("{n}.rho"),
+                T::BeamRho(i),
+                "kg/m3",
+                b.material.rho,
+                V::Fixed,
+                "Density",
+            );
+            real_param(
+                &mut t,
+                format!("{n}.E"),
+                T::BeamE(i),
+                "Pa",
+                b.material.e,
+                V::Fixed,
+                "Young's modulus",
+            );
+            if b.section.shape.is_none() {
+                real_param(
+                    &mut t,
+                    format!("{n}.A"),
+                    T::BeamArea(i),
+                    "m2",
+                    b.section.area.unwrap_or(0.0),
+                    V::Fixed,
+                    "Section area",
+                );
+                real_param(
+                    &mut t,
+                    format!("{n}.J"),
+                    T::BeamSecondMoment(i),
+                    "m4",
+                    b.section.second_moment.unwrap_or(0.0),
+                    V::Fixed,
+                    "Second moment of area, in-plane bending",
+                );
+            } else {
+                t.push(
+                    format!("{n}.A"),
+                    VarType::Real,
+                    C::CalculatedParameter,
+                    V::Fixed,
+                    Some("m2"),
+                    "Section area, from the section shape",
+                    None,
+                    O(K::SectionArea(i)),
+                );
+                t.push(
+                    format!("{n}.J"),
+                    VarType::Real,
+                    C::CalculatedParameter,
+                    V::Fixed,
+                    Some("m4"),
+                    "Second moment of area, from the section shape",
+                    None,
+                    O(K::SectionSecondMoment(i)),
+                );
+            }
+            real_param(
+                &mut t,
+                format!("{n}.rayleigh.alpha"),
+                T::BeamRayleighAlpha(i),
+                "1/s",
+                b.rayleigh.alpha,
+                V::Fixed,
+                "Rayleigh damping, mass-proportional",
+            );
+            real_param(
+                &mut t,
+                format!("{n}.rayleigh.beta"),
+                T::BeamRayleighBeta(i),
+                "s",
+                b.rayleigh.beta,
+                V::Fixed,
+                "Rayleigh damping, stiffness-proportional",
+            );
+            real_param(
+                &mut t,
+                format!("{n}.initial.tip_displacement"),
+                T::BeamTipDisplacement(i),
+                "m",
+                b.initial.tip_displacement,
+                V::Fixed,
+                "Initial static transverse tip displacement",
+            );
+        }
+        for (i, b) in scene.beams.iter().enumerate() {
+            for o in Scene::beam_outputs(b) {
+                let (kind, unit, desc) = match o {
+                    "tip.deflection" => (
+                        K::TipDeflection(i),
+                        "m",
+                        "Transverse displacement of flange b in the beam frame",
+                    ),
+                    "tip.x" => (K::TipX(i), "m", "World x of flange b"),
+                    "tip.y" => (K::TipY(i), "m", "World y of flange b"),
+                    _ => (K::TipPhi(i), "rad", "World rotation of flange b"),
+                };
+                t.output(
+                    format!("{}.{o}", b.name),
+                    VarType::Real,
+                    Some(unit),
+                    desc,
+                    kind,
+                );
+            }
+        }
+        for (name, kind, desc) in [
+            ("energy.kinetic", K::EnergyKinetic, "Kinetic energy"),
+            ("energy.strain", K::EnergyStrain, "Strain energy"),
+            (
+                "energy.potential",
+                K::EnergyPotential,
+                "Potential energy of gravity",
+            ),
+            (
+                "energy.total",
+                K::EnergyTotal,
+                "Kinetic + strain + potential energy",
+            ),
+        ] {
+            t.output(name.into(), VarType::Real, Some("J"), desc, kind);
+        }
+        for (name, kind, desc) in [
+            (
+                "solver.steps",
+                K::SolverSteps,
+                "Accepted internal steps since initialization",
+            ),
+            (
+                "solver.newton_iterations",
+                K::SolverNewtonIterations,
+                "Newton iterations since initialization",
+            ),
+            (
+                "solver.jacobians",
+                K::SolverJacobians,
+                "Iteration-matrix factorizations since initialization",
+            ),
+            (
+                "solver.rejected_steps",
+                K::SolverRejectedSteps,
+                "Rejected internal steps since initialization",
+            ),
+        ] {
+            t.output(name.into(), VarType::Integer, None, desc, kind);
+        }
+        VariableTable { variables: t.vars }
+    }
+
+    pub fn get(&self, vr: u32) -> Option<&Variable> {
+        self.variables.get(vr as usize)
+    }
+
+    pub fn by_name(&self, name: &str) -> Option<&Variable> {
+        self.variables.iter().find(|v| v.name == name)
+    }
+
+    /// The units used by at least one variable, in [`UNITS`] order.
+    pub fn units(&self) -> Vec<UnitDef> {
+        UNITS
+            .iter()
+            .copied()
+            .filter(|u| self.variables.iter().any(|v| v.unit == Some(u.name)))
+            .collect()
+    }
+}
+
+struct Builder {
+    vars: Vec<Variable>,
+}
+
+impl Builder {
+    fn push(
+        &mut self,
+        name: String,
+        ty: VarType,
+        causality: Causality,
+        variability: Variability,
+        unit: Option<&'static str>,
+        description: &str,
+        start: Option<f64>,
+        binding: Binding,
+    ) {
+        let initial = match causality {
+            Causality::Parameter => Some(Initial::Exact),
+            Causality::CalculatedParameter | Causality::Output => Some(Initial::Calculated),
+            Causality::Input => None,
+        };
+        let unit = unit.filter(|u| *u != "1");
+        self.vars.push(Variable {
+            name,
+            vr: self.vars.len() as u32,
+            ty,
+            causality,
+            variability,
+            initial,
+            unit,
+            description: description.to_string(),
+            start,
+            binding,
+        });
+    }
+
+    fn output(
+        &mut self,
+        name: String,
+        ty: VarType,
+        unit: Option<&'static str>,
+        desc: &str,
+        kind: OutputKind,
+    ) {
+        let variability = if ty == VarType::Real {
+            Variability::Continuous
+        } else {
+            Variability::Discrete
+        };
+        self.push(
+            name,
+            ty,
+            Causality::Output,
+            variability,
+            unit,
+            desc,
+            None,
+            Binding::Output(kind),
+        );
+    }
+}
