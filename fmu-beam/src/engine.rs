@@ -4,6 +4,7 @@
 
 use crate::error::EngineError;
 use crate::integrator::{self, GaState, Settings, Stats, Stepper};
+use crate::multibody::law::InputValue;
 use crate::multibody::System;
 use crate::scene::Scene;
 use crate::variables::{
@@ -17,6 +18,9 @@ struct Model {
     state: GaState,
     stats: Stats,
     stepper: Stepper,
+    /// System joint index of each scene joint, system body index of each scene body.
+    joint_index: Vec<usize>,
+    body_index: Vec<usize>,
 }
 
 /// Everything that changes while an instance runs; get/set FMU state copy exactly this.
@@ -25,6 +29,7 @@ pub struct Snapshot {
     initialized: bool,
     start_time: f64,
     values: Vec<f64>,
+    input_ders: Vec<[f64; 2]>,
     state: Option<(GaState, Stats)>,
 }
 
@@ -32,8 +37,14 @@ pub struct Snapshot {
 pub struct Engine {
     scene: Scene,
     table: VariableTable,
-    /// Current value of every parameter, indexed by value reference (outputs unused).
+    /// Current value of every parameter and input, indexed by value reference (outputs unused).
     values: Vec<f64>,
+    /// First and second time derivatives of the inputs (fmi2SetRealInputDerivatives).
+    input_ders: Vec<[f64; 2]>,
+    /// Beams already warned about leaving the small-deformation range.
+    warned: Vec<bool>,
+    /// Log messages (warnings) for the master, taken by the FMI layer.
+    messages: Vec<String>,
     initialized: bool,
     start_time: f64,
     model: Option<Model>,
@@ -45,12 +56,15 @@ const STATE_VERSION: u32 = 1;
 impl Engine {
     pub fn new(scene: Scene) -> Engine {
         let table = VariableTable::build(&scene);
-        let values = table
+        let values: Vec<f64> = table
             .variables
             .iter()
             .map(|v| v.start.unwrap_or(0.0))
             .collect();
         Engine {
+            input_ders: vec![[0.0; 2]; values.len()],
+            warned: vec![false; scene.beams.len()],
+            messages: Vec::new(),
             scene,
             table,
             values,
@@ -102,6 +116,68 @@ impl Engine {
         Ok(self.get(vr, VarType::Boolean)? != 0.0)
     }
 
+    /// fmi2SetRealInputDerivatives: derivative of `order` (1 or 2) of a Real input, used to
+    /// extrapolate it over the next communication step.
+    pub fn set_input_derivative(
+        &mut self,
+        vr: u32,
+        order: i32,
+        value: f64,
+    ) -> Result<(), EngineError> {
+        let i = self.lookup(vr, VarType::Real)?;
+        let var = &self.table.variables[i];
+        let Binding::Input(slot) = var.binding else {
+            return Err(EngineError::NotSettable {
+                name: var.name.clone(),
+                reason: "input derivatives are only for inputs".into(),
+            });
+        };
+        if !(1..=2).contains(&order) {
+            return Err(EngineError::InvalidValue {
+                name: var.name.clone(),
+                value: order as f64,
+                rule: "derivative order must be 1 or 2 (MaxInputDerivativeOrder)".into(),
+            });
+        }
+        if !value.is_finite() {
+            return Err(EngineError::NonFiniteValue {
+                name: var.name.clone(),
+                value,
+            });
+        }
+        self.input_ders[i][order as usize - 1] = value;
+        if let Some(m) = &mut self.model {
+            let u = &mut m.system.inputs[slot];
+            if order == 1 {
+                u.der1 = value;
+            } else {
+                u.der2 = value;
+            }
+        }
+        Ok(())
+    }
+
+    /// Log messages (warnings) collected since the last call.
+    pub fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    /// Copies the input values and derivatives into the system, held from time t0.
+    fn sync_inputs(&mut self, t0: f64) {
+        let Some(m) = &mut self.model else { return };
+        for (i, var) in self.table.variables.iter().enumerate() {
+            if let Binding::Input(slot) = var.binding {
+                let [der1, der2] = self.input_ders[i];
+                m.system.inputs[slot] = InputValue {
+                    value: self.values[i],
+                    der1,
+                    der2,
+                    t0,
+                };
+            }
+        }
+    }
+
     fn lookup(&self, vr: u32, ty: VarType) -> Result<usize, EngineError> {
         match self.table.get(vr) {
             Some(v) if v.ty == ty => Ok(vr as usize),
@@ -118,6 +194,20 @@ impl Engine {
         let name = var.name.clone();
         if !value.is_finite() {
             return Err(EngineError::NonFiniteValue { name, value });
+        }
+        if let Binding::Input(slot) = var.binding {
+            self.values[i] = value;
+            self.input_ders[i] = [0.0; 2];
+            let t0 = self.time();
+            if let Some(m) = &mut self.model {
+                m.system.inputs[slot] = InputValue {
+                    value,
+                    der1: 0.0,
+                    der2: 0.0,
+                    t0,
+                };
+            }
+            return Ok(());
         }
         let target = match (var.causality, var.binding) {
             (Causality::Parameter, Binding::Parameter(t)) => t,
@@ -157,7 +247,7 @@ impl Engine {
     fn get(&mut self, vr: u32, ty: VarType) -> Result<f64, EngineError> {
         let i = self.lookup(vr, ty)?;
         match self.table.variables[i].binding {
-            Binding::Parameter(_) => Ok(self.values[i]),
+            Binding::Parameter(_) | Binding::Input(_) => Ok(self.values[i]),
             Binding::Output(kind) => {
                 let m = self.built()?;
                 Ok(output(m, kind))
@@ -183,12 +273,42 @@ impl Engine {
             scene.validate("parameters")?;
             let system = System::from_scene(&scene);
             let settings = Settings::from_scene(&scene);
+            let mut system = system;
+            for (i, var) in self.table.variables.iter().enumerate() {
+                if let Binding::Input(slot) = var.binding {
+                    let [der1, der2] = self.input_ders[i];
+                    system.inputs[slot] = InputValue {
+                        value: self.values[i],
+                        der1,
+                        der2,
+                        t0: self.start_time,
+                    };
+                }
+            }
             let state = integrator::initial_state(&system, &scene, self.start_time, &settings)?;
+            let joint_index = scene
+                .joints
+                .iter()
+                .map(|j| system.joint_index(&j.name).expect("scene joint in system"))
+                .collect();
+            let body_index = scene
+                .bodies
+                .iter()
+                .map(|b| {
+                    system
+                        .bodies
+                        .iter()
+                        .position(|x| x.name() == b.name)
+                        .expect("scene body in system")
+                })
+                .collect();
             self.model = Some(Model {
                 stepper: Stepper::new(&system, settings),
                 system,
                 state,
                 stats: Stats::default(),
+                joint_index,
+                body_index,
             });
         }
         Ok(self.model.as_mut().expect("model built above"))
@@ -236,16 +356,57 @@ impl Engine {
                 ),
             });
         }
-        let m = self.built()?;
+        self.built()?;
+        self.sync_inputs(now);
+        let m = self.model.as_mut().expect("built above");
         let saved = (m.state.clone(), m.stats);
-        let result = m
+        let mut result = m
             .stepper
             .step_to(&m.system, &mut m.state, &mut m.stats, now + h);
+        if result.is_ok() {
+            result = self.monitor_validity();
+        }
         if result.is_err() {
+            let m = self.model.as_mut().expect("built above");
             m.state = saved.0;
             m.stats = saved.1;
         }
         result
+    }
+
+    /// The validity monitor: a single-frame beam assumes small deformation. Beyond 5 % of its
+    /// length it warns once; beyond its length the solution has run away (a linear beam spun
+    /// above its first bending frequency) and the step is refused.
+    fn monitor_validity(&mut self) -> Result<(), EngineError> {
+        let m = self.model.as_ref().expect("model built");
+        let sys = &m.system;
+        for (g, grp) in sys.beams.iter().enumerate() {
+            if grp.bodies.len() != 1 || sys.beam(grp.bodies.start).is_none() {
+                continue;
+            }
+            let (tip, _) = sys.beam_tip(g, &m.state.q);
+            let defl = sys.beam_transverse(g, &m.state.q, tip).abs();
+            let t = m.state.t;
+            if defl > grp.length || !defl.is_finite() {
+                return Err(EngineError::Runaway {
+                    beam: grp.name.clone(),
+                    t,
+                    deflection: defl,
+                    length: grp.length,
+                });
+            }
+            if defl > 0.05 * grp.length && !self.warned[g] {
+                self.warned[g] = true;
+                self.messages.push(format!(
+                    "beam '{}': tip deflection {defl:.3e} m at t = {t} s is {:.1} % of its length, \
+                     beyond the small-deformation range of a single floating frame; use \
+                     substructures (or geometric_stiffening for a spinning beam)",
+                    grp.name,
+                    100.0 * defl / grp.length
+                ));
+            }
+        }
+        Ok(())
     }
 
     pub fn snapshot(&self) -> Snapshot {
@@ -253,12 +414,14 @@ impl Engine {
             initialized: self.initialized,
             start_time: self.start_time,
             values: self.values.clone(),
+            input_ders: self.input_ders.clone(),
             state: self.model.as_ref().map(|m| (m.state.clone(), m.stats)),
         }
     }
 
     pub fn restore(&mut self, s: &Snapshot) -> Result<(), EngineError> {
         self.values = s.values.clone();
+        self.input_ders = s.input_ders.clone();
         self.start_time = s.start_time;
         self.model = None;
         self.initialized = false;
@@ -293,6 +456,8 @@ impl Engine {
         w.push(s.initialized as u8);
         w.extend_from_slice(&s.start_time.to_le_bytes());
         put_vec(&mut w, &s.values);
+        let ders: Vec<f64> = s.input_ders.iter().flatten().copied().collect();
+        put_vec(&mut w, &ders);
         match &s.state {
             None => w.push(0),
             Some((st, stats)) => {
@@ -330,6 +495,11 @@ impl Engine {
         if values.len() != self.values.len() {
             return Err(bad("wrong number of parameter values"));
         }
+        let ders = r.vec()?;
+        if ders.len() != 2 * self.values.len() {
+            return Err(bad("wrong number of input derivatives"));
+        }
+        let input_ders = ders.chunks(2).map(|c| [c[0], c[1]]).collect();
         let state = match r.u8()? {
             0 => None,
             1 => Some((GaState::read(&mut r)?, Stats::read(&mut r)?)),
@@ -338,13 +508,14 @@ impl Engine {
         if r.pos != bytes.len() {
             return Err(bad("trailing bytes after the state"));
         }
-        if values.iter().any(|v| !v.is_finite()) || !start_time.is_finite() {
+        if values.iter().chain(ders.iter()).any(|v| !v.is_finite()) || !start_time.is_finite() {
             return Err(bad("non-finite values"));
         }
         Ok(Snapshot {
             initialized,
             start_time,
             values,
+            input_ders,
             state,
         })
     }
@@ -367,37 +538,42 @@ fn apply(s: &mut Scene, t: ParamTarget, v: f64) {
         T::BeamRayleighAlpha(i) => s.beams[i].rayleigh.alpha = v,
         T::BeamRayleighBeta(i) => s.beams[i].rayleigh.beta = v,
         T::BeamTipDisplacement(i) => s.beams[i].initial.tip_displacement = v,
+        T::DriveValue(j) => law_mut(s, j).value = Some(v),
+        T::DriveOmega(j) => law_mut(s, j).omega = Some(v),
+        T::DriveRampTime(j) => law_mut(s, j).ramp_time = Some(v),
+        T::DriveTimeConstant(j) => law_mut(s, j).time_constant = Some(v),
+        T::DriveUntil(j) => law_mut(s, j).until = Some(v),
     }
+}
+
+fn law_mut(s: &mut Scene, joint: usize) -> &mut crate::scene::LawSpec {
+    &mut s.joints[joint]
+        .drive
+        .as_mut()
+        .expect("drive parameters exist only for drives")
+        .law
 }
 
 fn output(m: &Model, kind: OutputKind) -> f64 {
     use OutputKind as K;
     let sys = &m.system;
-    let (q, v) = (&m.state.q, &m.state.v);
-    let tip = |i: usize| {
-        let b = &sys.bodies[i];
-        let z = sys.body_coords(i, q);
-        (b, z)
-    };
+    let st = &m.state;
+    let (q, v) = (&st.q, &st.v);
     match kind {
-        K::TipDeflection(i) => {
-            let (b, z) = tip(i);
-            b.local_point(&b.flange_b, &z)[1]
-        }
-        K::TipX(i) => {
-            let (b, z) = tip(i);
-            b.point(&b.flange_b, &z).0[0]
-        }
-        K::TipY(i) => {
-            let (b, z) = tip(i);
-            b.point(&b.flange_b, &z).0[1]
-        }
-        K::TipPhi(i) => {
-            let (b, z) = tip(i);
-            b.point(&b.flange_b, &z).1
-        }
-        K::SectionArea(i) => sys.bodies[i].section.area,
-        K::SectionSecondMoment(i) => sys.bodies[i].section.second_moment,
+        K::TipDeflection(g) => sys.beam_transverse(g, q, sys.beam_tip(g, q).0),
+        K::TipX(g) => sys.beam_tip(g, q).0[0],
+        K::TipY(g) => sys.beam_tip(g, q).0[1],
+        K::TipPhi(g) => sys.beam_tip(g, q).1,
+        K::MidDeflection(g) => sys.beam_transverse(g, q, sys.beam_mid(g, q)),
+        K::SectionArea(g) => beam_section(sys, g).area,
+        K::SectionSecondMoment(g) => beam_section(sys, g).second_moment,
+        K::JointCoordinate(j) => sys.joint_coordinate(m.joint_index[j], q, v).0,
+        K::JointRate(j) => sys.joint_coordinate(m.joint_index[j], q, v).1,
+        K::JointEffort(j) => sys.joint_effort(m.joint_index[j], &st.lambda, st.t),
+        K::BodyX(b) => q[sys.offsets[m.body_index[b]]],
+        K::BodyY(b) => q[sys.offsets[m.body_index[b]] + 1],
+        K::BodyPhi(b) => q[sys.offsets[m.body_index[b]] + 2],
+        K::EnergyWork => st.work,
         K::EnergyKinetic => sys.energy(q, v).kinetic,
         K::EnergyStrain => sys.energy(q, v).strain,
         K::EnergyPotential => sys.energy(q, v).potential,
@@ -407,6 +583,10 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
         K::SolverJacobians => m.stats.jacobians as f64,
         K::SolverRejectedSteps => m.stats.rejected as f64,
     }
+}
+
+fn beam_section(sys: &System, g: usize) -> crate::beam::section::Section {
+    sys.beams[g].section
 }
 
 fn put_vec(w: &mut Vec<u8>, v: &[f64]) {

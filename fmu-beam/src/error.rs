@@ -45,6 +45,18 @@ pub enum EngineError {
         h_min: f64,
         tolerance: f64,
     },
+    #[error(
+        "beam '{beam}': tip deflection {deflection:.3e} m exceeds its length {length} m at \
+         t = {t} s: the single-frame solution has run away (a linear beam spun near or above \
+         its first bending frequency softens without bound); use substructures or \
+         geometric_stiffening"
+    )]
+    Runaway {
+        beam: String,
+        t: f64,
+        deflection: f64,
+        length: f64,
+    },
     #[error("unknown value reference {vr} for a variable of type {ty}")]
     UnknownValueReference { vr: u32, ty: &'static str },
     #[error("variable '{name}' cannot be set now: {reason}")]
@@ -73,6 +85,7 @@ impl EngineError {
                 | EngineError::SingularMatrix { .. }
                 | EngineError::NonFinite { .. }
                 | EngineError::StepTooSmall { .. }
+                | EngineError::Runaway { .. }
         )
     }
 }

@@ -7,6 +7,7 @@
 pub mod beam;
 pub mod engine;
 pub mod error;
+pub mod fmi2;
 pub mod integrator;
 pub mod modes;
 pub mod multibody;

@@ -33,8 +33,8 @@ pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
     let mut ct = DMatrix::zeros(n, n);
     let mut gm = DMatrix::zeros(m, n);
     sys.mass_matrix(&st.q, &mut mm);
-    sys.tangents(&st.q, &zero, &zero, &st.lambda, &mut kt, &mut ct);
-    sys.constraint_jacobian(&st.q, &mut gm);
+    sys.tangents(&st.q, &zero, &zero, &st.lambda, 0.0, &mut kt, &mut ct);
+    sys.constraint_jacobian(&st.q, 0.0, &mut gm);
     let basis = null_space(&gm, n);
     let mr = basis.transpose() * &mm * &basis;
     let kr = basis.transpose() * &kt * &basis;

@@ -91,16 +91,34 @@ pub enum ParamTarget {
     BeamRayleighAlpha(usize),
     BeamRayleighBeta(usize),
     BeamTipDisplacement(usize),
+    /// A parameter of a joint's drive law.
+    DriveValue(usize),
+    DriveOmega(usize),
+    DriveRampTime(usize),
+    DriveTimeConstant(usize),
+    DriveUntil(usize),
 }
 
 /// What an output or calculated parameter reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OutputKind {
-    /// Transverse displacement of flange b in the beam frame (m).
+    /// Transverse displacement of flange b from the root frame's axis, in the root frame (m).
     TipDeflection(usize),
     TipX(usize),
     TipY(usize),
     TipPhi(usize),
+    /// Transverse displacement at mid-span from the root axis (tangent) or the chord (pinned).
+    MidDeflection(usize),
+    /// Joint coordinate, its rate, and the effort of its drive (scene joint index).
+    JointCoordinate(usize),
+    JointRate(usize),
+    JointEffort(usize),
+    /// Pose of a rigid body (scene body index).
+    BodyX(usize),
+    BodyY(usize),
+    BodyPhi(usize),
+    /// Work done by drives and loads since the start (J).
+    EnergyWork,
     /// Calculated section constants of a beam whose section is a shape.
     SectionArea(usize),
     SectionSecondMoment(usize),
@@ -118,6 +136,8 @@ pub enum OutputKind {
 pub enum Binding {
     Parameter(ParamTarget),
     Output(OutputKind),
+    /// FMU input in this slot of `multibody::system::input_slots`.
+    Input(usize),
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -400,6 +420,89 @@ impl VariableTable {
                 "Initial static transverse tip displacement",
             );
         }
+        for (i, j) in scene.joints.iter().enumerate() {
+            let Some(d) = &j.drive else { continue };
+            let unit = match (j.kind, d.kind) {
+                (crate::scene::JointKind::Prismatic, crate::scene::DriveKind::Motion) => "m",
+                (crate::scene::JointKind::Prismatic, crate::scene::DriveKind::Effort) => "N",
+                (_, crate::scene::DriveKind::Motion) => "rad",
+                (_, crate::scene::DriveKind::Effort) => "N.m",
+            };
+            let law = &d.law;
+            let n = &j.name;
+            if law.law != "input" {
+                if let Some(v) = law.value {
+                    real_param(
+                        &mut t,
+                        format!("{n}.drive.value"),
+                        T::DriveValue(i),
+                        unit,
+                        v,
+                        V::Fixed,
+                        "Drive law: value or amplitude",
+                    );
+                }
+            }
+            if let Some(v) = law.omega {
+                real_param(
+                    &mut t,
+                    format!("{n}.drive.omega"),
+                    T::DriveOmega(i),
+                    "rad/s",
+                    v,
+                    V::Fixed,
+                    "Spin-up law: final angular speed",
+                );
+            }
+            if let Some(v) = law.ramp_time {
+                real_param(
+                    &mut t,
+                    format!("{n}.drive.ramp_time"),
+                    T::DriveRampTime(i),
+                    "s",
+                    v,
+                    V::Fixed,
+                    "Spin-up law: duration T of the ramp",
+                );
+            }
+            if let Some(v) = law.time_constant {
+                real_param(
+                    &mut t,
+                    format!("{n}.drive.time_constant"),
+                    T::DriveTimeConstant(i),
+                    "s",
+                    v,
+                    V::Fixed,
+                    "Exponential law: time constant",
+                );
+            }
+            if let Some(v) = law.until {
+                real_param(
+                    &mut t,
+                    format!("{n}.drive.until"),
+                    T::DriveUntil(i),
+                    "s",
+                    v,
+                    V::Fixed,
+                    "The drive law is zero after this time",
+                );
+            }
+        }
+        for (slot, input) in crate::multibody::system::input_slots(scene)
+            .into_iter()
+            .enumerate()
+        {
+            t.push(
+                input.name,
+                VarType::Real,
+                C::Input,
+                V::Continuous,
+                Some(input.unit),
+                &input.description,
+                Some(input.start),
+                Binding::Input(slot),
+            );
+        }
         for (i, b) in scene.beams.iter().enumerate() {
             for o in Scene::beam_outputs(b) {
                 let (kind, unit, desc) = match o {
@@ -410,6 +513,8 @@ impl VariableTable {
                     ),
                     "tip.x" => (K::TipX(i), "m", "World x of flange b"),
                     "tip.y" => (K::TipY(i), "m", "World y of flange b"),
+                    "mid.deflection" => (K::MidDeflection(i), "m",
+                        "Transverse displacement at mid-span from the root axis (the chord for a pinned frame)"),
                     _ => (K::TipPhi(i), "rad", "World rotation of flange b"),
                 };
                 t.output(
@@ -421,7 +526,78 @@ impl VariableTable {
                 );
             }
         }
+        for (i, j) in scene.joints.iter().enumerate() {
+            let n = &j.name;
+            match j.kind {
+                crate::scene::JointKind::Revolute => {
+                    t.output(
+                        format!("{n}.angle"),
+                        VarType::Real,
+                        Some("rad"),
+                        "Joint angle, frame 1 relative to frame 0",
+                        K::JointCoordinate(i),
+                    );
+                    t.output(
+                        format!("{n}.speed"),
+                        VarType::Real,
+                        Some("rad/s"),
+                        "Joint angular speed",
+                        K::JointRate(i),
+                    );
+                    t.output(format!("{n}.torque"), VarType::Real, Some("N.m"),
+                        "Torque of the joint's drive on frame 1 (the reaction of a motion drive; 0 without drive)", K::JointEffort(i));
+                }
+                crate::scene::JointKind::Prismatic => {
+                    t.output(
+                        format!("{n}.position"),
+                        VarType::Real,
+                        Some("m"),
+                        "Position of frame 1 along the axis of frame 0",
+                        K::JointCoordinate(i),
+                    );
+                    t.output(
+                        format!("{n}.velocity"),
+                        VarType::Real,
+                        Some("m/s"),
+                        "Sliding velocity",
+                        K::JointRate(i),
+                    );
+                    t.output(format!("{n}.force"), VarType::Real, Some("N"),
+                        "Force of the joint's drive on frame 1 along the axis (the reaction of a motion drive; 0 without drive)", K::JointEffort(i));
+                }
+                crate::scene::JointKind::Weld => {}
+            }
+        }
+        for (i, b) in scene.bodies.iter().enumerate() {
+            let n = &b.name;
+            t.output(
+                format!("{n}.x"),
+                VarType::Real,
+                Some("m"),
+                "World x of the body frame",
+                K::BodyX(i),
+            );
+            t.output(
+                format!("{n}.y"),
+                VarType::Real,
+                Some("m"),
+                "World y of the body frame",
+                K::BodyY(i),
+            );
+            t.output(
+                format!("{n}.phi"),
+                VarType::Real,
+                Some("rad"),
+                "World angle of the body frame",
+                K::BodyPhi(i),
+            );
+        }
         for (name, kind, desc) in [
+            (
+                "energy.work",
+                K::EnergyWork,
+                "Work done by drives and loads since the start",
+            ),
             ("energy.kinetic", K::EnergyKinetic, "Kinetic energy"),
             ("energy.strain", K::EnergyStrain, "Strain energy"),
             (

@@ -10,7 +10,7 @@
 //! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
 //! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
 
-use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
+use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4, GAUSS_5};
 use super::section::Section;
 use crate::scene::{BeamSpec, FrameKind};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix2, Vector2};
@@ -73,6 +73,8 @@ pub struct PlanarBeam {
     pub dff: DMatrix<f64>,
     pub flange_a: PointMap,
     pub flange_b: PointMap,
+    /// Nonlinear axial strain ε = u' + v'²/2 (geometric stiffening), when on.
+    pub geometric_stiffening: bool,
 }
 
 /// Full-beam integrals before the boundary conditions remove coordinates.
@@ -92,7 +94,7 @@ impl PlanarBeam {
         PlanarBeam::new(
             &spec.name,
             spec.length,
-            spec.elements,
+            crate::scene::Scene::beam_layout(spec).0,
             spec.frame,
             spec.material.rho,
             spec.material.e,
@@ -167,6 +169,7 @@ impl PlanarBeam {
             flange_a: node_map(0, 0.0),
             flange_b: node_map(elements, length),
             kept,
+            geometric_stiffening: false,
         }
     }
 
@@ -262,6 +265,9 @@ impl PlanarBeam {
         for k in 0..nf {
             r[FLEX + k] += rf[k];
         }
+        if self.geometric_stiffening {
+            self.stiffening_force(z, &mut r[FLEX..FLEX + nf]);
+        }
     }
 
     /// Tangents of the residual: K_t = ∂r/∂z (at fixed ż, z̈) and C_t = ∂r/∂ż, added into the
@@ -332,6 +338,9 @@ impl PlanarBeam {
                 ct[(FLEX + k, FLEX + l)] += -2.0 * td * self.w[(k, l)] + self.dff[(k, l)];
             }
         }
+        if self.geometric_stiffening {
+            self.stiffening_tangent(z, &mut kt);
+        }
     }
 
     /// Kinetic energy ½ żᵀ M ż (J).
@@ -345,7 +354,12 @@ impl PlanarBeam {
     /// Strain energy ½ q_fᵀ K_ff q_f (J).
     pub fn strain_energy(&self, z: &DVector<f64>) -> f64 {
         let f = z.rows(FLEX, self.nflex());
-        0.5 * f.dot(&(&self.kff * f))
+        let extra = if self.geometric_stiffening {
+            self.stiffening_energy(z)
+        } else {
+            0.0
+        };
+        0.5 * f.dot(&(&self.kff * f)) + extra
     }
 
     /// Potential energy of gravity -g·∫ρ r dV (J).
@@ -370,6 +384,107 @@ impl PlanarBeam {
     /// Position of the map in the beam frame, s = s0 + S_p q_f.
     pub fn local_point(&self, map: &PointMap, z: &DVector<f64>) -> Vector2<f64> {
         map.s0 + &map.sp * z.rows(FLEX, self.nflex())
+    }
+
+    /// The material point at distance x from flange a along the undeformed axis.
+    pub fn point_map(&self, x: f64) -> PointMap {
+        let l = self.length / self.elements as f64;
+        let j = ((x / l).floor() as usize).min(self.elements - 1);
+        let xi = (x / l - j as f64).clamp(0.0, 1.0);
+        let (s1, s2) = planar_element::shape(xi, l);
+        let sl = planar_element::slope(xi, l);
+        let nf = self.nflex();
+        let mut sp = DMatrix::zeros(2, nf);
+        let mut sphi = DVector::zeros(nf);
+        for p in 0..ELEMENT_DOFS {
+            if let Some(k) = self.flex_index(3 * j + p) {
+                sp[(0, k)] = s1[p];
+                sp[(1, k)] = s2[p];
+                sphi[k] = sl[p];
+            }
+        }
+        PointMap {
+            s0: Vector2::new(x, 0.0),
+            sp,
+            sphi,
+        }
+    }
+
+    pub fn set_geometric_stiffening(&mut self, on: bool) {
+        self.geometric_stiffening = on;
+    }
+
+    /// Visits each element's Gauss points with the strain terms of the nonlinear axial strain:
+    /// (element root index, weight × length, u', v', d(u')/dq_e, d(v')/dq_e).
+    fn for_strain_points(
+        &self,
+        z: &DVector<f64>,
+        mut visit: impl FnMut(
+            &[Option<usize>; ELEMENT_DOFS],
+            f64,
+            f64,
+            f64,
+            &[f64; ELEMENT_DOFS],
+            &[f64; ELEMENT_DOFS],
+        ),
+    ) {
+        let l = self.length / self.elements as f64;
+        let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+        for j in 0..self.elements {
+            let idx: [Option<usize>; ELEMENT_DOFS] =
+                std::array::from_fn(|p| self.flex_index(3 * j + p));
+            let qe: [f64; ELEMENT_DOFS] =
+                std::array::from_fn(|p| idx[p].map_or(0.0, |k| z[FLEX + k]));
+            let du: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
+            for &(xi, w) in &GAUSS_5 {
+                let ds = planar_element::slope(xi, l);
+                let dv: f64 = (0..ELEMENT_DOFS).map(|p| ds[p] * qe[p]).sum();
+                visit(&idx, w * l, du, dv, &da, &ds);
+            }
+        }
+    }
+
+    /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
+    /// ∫EA (ε ∂ε/∂q - u' ∂u'/∂q) dx, added into `out`.
+    fn stiffening_force(&self, z: &DVector<f64>, out: &mut [f64]) {
+        let ea = self.ea;
+        self.for_strain_points(z, |idx, wl, du, dv, da, ds| {
+            let eps = du + 0.5 * dv * dv;
+            for p in 0..ELEMENT_DOFS {
+                if let Some(k) = idx[p] {
+                    out[k] += wl * ea * (eps * (da[p] + dv * ds[p]) - du * da[p]);
+                }
+            }
+        });
+    }
+
+    /// Tangent of [`Self::stiffening_force`], added into `k` (nf × nf block at (FLEX, FLEX)).
+    fn stiffening_tangent(&self, z: &DVector<f64>, kt: &mut DMatrixViewMut<f64>) {
+        let ea = self.ea;
+        self.for_strain_points(z, |idx, wl, du, dv, da, ds| {
+            let eps = du + 0.5 * dv * dv;
+            for p in 0..ELEMENT_DOFS {
+                let Some(kp) = idx[p] else { continue };
+                for r in 0..ELEMENT_DOFS {
+                    let Some(kr) = idx[r] else { continue };
+                    let de_p = da[p] + dv * ds[p];
+                    let de_r = da[r] + dv * ds[r];
+                    kt[(FLEX + kp, FLEX + kr)] +=
+                        wl * ea * (de_p * de_r + eps * ds[p] * ds[r] - da[p] * da[r]);
+                }
+            }
+        });
+    }
+
+    /// Strain energy of the nonlinear strain beyond ½ q_fᵀ K_ff q_f.
+    fn stiffening_energy(&self, z: &DVector<f64>) -> f64 {
+        let mut e = 0.0;
+        let ea = self.ea;
+        self.for_strain_points(z, |_, wl, du, dv, _, _| {
+            let eps = du + 0.5 * dv * dv;
+            e += 0.5 * wl * ea * (eps * eps - du * du);
+        });
+        e
     }
 
     /// Static deformation under a transverse tip force, scaled to a tip displacement `tip`

@@ -27,6 +27,8 @@ pub struct GaState {
     /// True acceleration q''.
     pub qdd: DVector<f64>,
     pub lambda: DVector<f64>,
+    /// Work done by drives and loads since the start (J), trapezoidal in time.
+    pub work: f64,
 }
 
 /// Coefficients of the scheme for a spectral radius at infinity ρ∞.
@@ -92,15 +94,14 @@ enum Failure {
 impl Stepper {
     pub fn new(sys: &System, settings: Settings) -> Stepper {
         let (n, m) = (sys.n(), sys.m());
-        let length = sys.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
-        let mut scale = DVector::from_element(n, length);
+        let mut scale = DVector::zeros(n);
         for (i, b) in sys.bodies.iter().enumerate() {
-            let o = sys.offsets[i];
-            scale[o + 2] = 1.0;
-            for (k, &full) in b.kept.iter().enumerate() {
-                if full % 3 == 2 {
-                    scale[o + 3 + k] = 1.0;
-                }
+            for k in 0..b.ndof() {
+                scale[sys.offsets[i] + k] = if b.is_angle(k) {
+                    1.0
+                } else {
+                    sys.length_scale()
+                };
             }
         }
         scale *= 1e-3;
@@ -154,11 +155,18 @@ impl Stepper {
         } else {
             set.max_step
         };
+        let breakpoints = sys.breakpoints();
         while st.t < t_end {
-            let remaining = t_end - st.t;
-            if remaining <= 4.0 * f64::EPSILON * t_end.abs().max(1.0) {
-                st.t = t_end;
-                break;
+            // land on the end of the communication step, or on a jump of a drive law before it
+            let target = breakpoints
+                .iter()
+                .copied()
+                .find(|&b| b > st.t * (1.0 + 1e-14) + 1e-14 && b < t_end)
+                .unwrap_or(t_end);
+            let remaining = target - st.t;
+            if remaining <= 4.0 * f64::EPSILON * target.abs().max(1.0) {
+                st.t = target;
+                continue;
             }
             let mut h = h_try.min(set.max_step);
             if !set.adaptive {
@@ -171,14 +179,18 @@ impl Stepper {
                 h = 0.5 * remaining;
             }
             let last = h >= remaining;
-            match self.attempt(sys, st, stats, h) {
+            let t_new = if last { target } else { st.t + h };
+            match self.attempt(sys, st, stats, h, t_new) {
                 Ok((new, err)) => {
                     if set.adaptive && err > 1.0 {
                         stats.rejected += 1;
                         h_try = h * (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0);
                     } else {
+                        let p0 = sys.power(&st.q, &st.v, &st.lambda, st.t);
+                        let p1 = sys.power(&new.q, &new.v, &new.lambda, t_new);
                         *st = new;
-                        st.t = if last { t_end } else { st.t + h };
+                        st.work += 0.5 * h * (p0 + p1);
+                        st.t = t_new;
                         stats.steps += 1;
                         if set.adaptive {
                             let grow = if err > 0.0 {
@@ -251,6 +263,7 @@ impl Stepper {
         v: &DVector<f64>,
         qdd: &DVector<f64>,
         lambda: &DVector<f64>,
+        t: f64,
         h: f64,
         c: &Coefficients,
         stats: &mut Stats,
@@ -260,8 +273,8 @@ impl Stepper {
         let beta_p = (1.0 - c.alpha_m) / (d * (1.0 - c.alpha_f));
         let gamma_p = c.gamma / (c.beta * h);
         sys.mass_matrix(q, &mut self.mm);
-        sys.tangents(q, v, qdd, lambda, &mut self.kt, &mut self.ct);
-        sys.constraint_jacobian(q, &mut self.gm);
+        sys.tangents(q, v, qdd, lambda, t, &mut self.kt, &mut self.ct);
+        sys.constraint_jacobian(q, t, &mut self.gm);
         let mut top = self.jac.view_mut((0, 0), (n, n));
         top.copy_from(&self.kt);
         top *= d;
@@ -290,6 +303,7 @@ impl Stepper {
         st: &GaState,
         stats: &mut Stats,
         h: f64,
+        t_new: f64,
     ) -> Result<(GaState, f64), Failure> {
         let c = Coefficients::new(self.settings.rho_inf);
         let (n, m) = (sys.n(), sys.m());
@@ -311,15 +325,15 @@ impl Stepper {
         let mut norm = f64::INFINITY;
         for it in 0..MAX_NEWTON {
             if self.lu.is_none() {
-                if !self.factorize(sys, &q, &v, &qdd, &lambda, h, &c, stats) {
+                if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c, stats) {
                     return Err(Failure::Singular);
                 }
                 fresh = true;
             }
-            sys.body_residual(&q, &v, &qdd, &mut self.r);
-            sys.constraint_jacobian(&q, &mut self.gm);
+            sys.body_residual(&q, &v, &qdd, t_new, &mut self.r);
+            sys.constraint_jacobian(&q, t_new, &mut self.gm);
             self.r.gemv_tr(1.0, &self.gm, &lambda, 1.0);
-            sys.constraints(&q, &mut self.g);
+            sys.constraints(&q, t_new, &mut self.g);
             self.rhs.rows_mut(0, n).copy_from(&(&self.r * (-d)));
             self.rhs.rows_mut(n, m).copy_from(&(-&self.g));
             let lu = self.lu.as_ref().ok_or(Failure::Singular)?;
@@ -359,6 +373,7 @@ impl Stepper {
                         acc,
                         qdd,
                         lambda,
+                        work: st.work,
                     },
                     err,
                 ));

@@ -19,16 +19,15 @@ pub fn initial_state(
     let (n, m) = (sys.n(), sys.m());
     let mut q = sys.initial_coordinates(scene)?;
     let v = DVector::zeros(n);
-    let length = sys.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
-    let tol = 1e-12 * length.max(1.0);
+    let tol = 1e-12 * sys.length_scale().max(1.0);
     let mut g = DVector::zeros(m);
     let mut gm = DMatrix::zeros(m, n);
     if m > 0 {
-        sys.constraint_jacobian(&q, &mut gm);
+        sys.constraint_jacobian(&q, t0, &mut gm);
         check_rank(sys, &gm, t0)?;
         let mut iterations = 0;
         loop {
-            sys.constraints(&q, &mut g);
+            sys.constraints(&q, t0, &mut g);
             let residual = g.amax();
             if residual <= tol {
                 break;
@@ -43,7 +42,7 @@ pub fn initial_state(
                     iterations,
                 });
             }
-            sys.constraint_jacobian(&q, &mut gm);
+            sys.constraint_jacobian(&q, t0, &mut gm);
             // minimum-norm correction Δq = -Gᵀ (G Gᵀ)⁻¹ g
             let ggt = &gm * gm.transpose();
             let y = ggt.lu().solve(&g).ok_or_else(|| EngineError::Assembly {
@@ -71,6 +70,7 @@ pub fn initial_state(
         lambda,
         q,
         v,
+        work: 0.0,
     })
 }
 
@@ -112,11 +112,11 @@ pub fn consistent_accelerations(
     let mut mm = DMatrix::zeros(n, n);
     sys.mass_matrix(q, &mut mm);
     let mut gm = DMatrix::zeros(m, n);
-    sys.constraint_jacobian(q, &mut gm);
+    sys.constraint_jacobian(q, t, &mut gm);
     let mut r = DVector::zeros(n);
-    sys.body_residual(q, v, &DVector::zeros(n), &mut r);
+    sys.body_residual(q, v, &DVector::zeros(n), t, &mut r);
     let mut bias = DVector::zeros(m);
-    sys.accel_bias(q, v, &mut bias);
+    sys.accel_bias(q, v, t, &mut bias);
     let mut a = DMatrix::zeros(n + m, n + m);
     a.view_mut((0, 0), (n, n)).copy_from(&mm);
     a.view_mut((0, n), (n, m)).copy_from(&gm.transpose());

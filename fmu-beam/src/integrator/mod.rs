@@ -65,6 +65,7 @@ impl GaState {
     pub(crate) fn write(&self, w: &mut Vec<u8>) {
         w.extend_from_slice(&self.t.to_le_bytes());
         w.extend_from_slice(&self.h.to_le_bytes());
+        w.extend_from_slice(&self.work.to_le_bytes());
         for v in [&self.q, &self.v, &self.acc, &self.qdd, &self.lambda] {
             write_vec(w, v.as_slice());
         }
@@ -73,6 +74,7 @@ impl GaState {
     pub(crate) fn read(r: &mut Reader) -> Result<GaState, EngineError> {
         let t = r.f64()?;
         let h = r.f64()?;
+        let work = r.f64()?;
         let mut vs = Vec::with_capacity(5);
         for _ in 0..5 {
             vs.push(nalgebra::DVector::from_vec(r.vec()?));
@@ -83,7 +85,11 @@ impl GaState {
                 message: "state vectors of different lengths".into(),
             });
         }
-        if !t.is_finite() || !h.is_finite() || vs.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
+        if !t.is_finite()
+            || !h.is_finite()
+            || !work.is_finite()
+            || vs.iter().any(|v| v.iter().any(|x| !x.is_finite()))
+        {
             return Err(EngineError::BadState {
                 message: "non-finite numbers in the state".into(),
             });
@@ -101,6 +107,7 @@ impl GaState {
             acc,
             qdd,
             lambda,
+            work,
         })
     }
 }

@@ -1,6 +1,12 @@
 //! Bodies, frames and joints, assembled into M(q) q'' + G(q)ᵀλ = Q(q, q', t); g(q, t) = 0.
 
+pub mod body;
 pub mod frame;
+pub mod joint;
+pub mod law;
+pub mod prismatic;
+pub mod revolute;
+pub mod rigid_body;
 pub mod system;
 pub mod weld;
 

@@ -1,14 +1,18 @@
-//! The assembled multibody system: bodies stacked in q, joints stacked in g.
+//! The assembled multibody system: bodies stacked in q, joint equations stacked in g.
 //!
 //! Residual of the equations of motion (what the integrator drives to zero):
-//! r(q, q', q'', λ) = Σ_bodies r_body + G(q)ᵀ λ,   and   g(q) = 0.
+//! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
 
-use super::frame::{self, Frame};
-use super::weld::Weld;
-use crate::beam::planar_beam::PlanarBeam;
+use super::body::Body;
+use super::frame::{self, Frame, FrameState};
+use super::joint::{Drive, Joint, Row};
+use super::law::{InputValue, TimeLaw};
+use super::rigid_body::RigidBody;
+use crate::beam::planar_beam::{rot, PlanarBeam, PointMap};
 use crate::error::EngineError;
-use crate::scene::{JointKind, Scene};
+use crate::scene::{DriveKind, JointKind, Scene};
 use nalgebra::{DMatrix, DVector, Vector2};
+use std::ops::Range;
 
 /// Energies of the system (J).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -24,59 +28,319 @@ impl Energy {
     }
 }
 
+/// An FMU input of the scene, in slot order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSlot {
+    pub name: String,
+    pub unit: &'static str,
+    pub start: f64,
+    pub description: String,
+}
+
+/// The FMU inputs a scene offers: drives with law "input", then loads marked `input`.
+pub fn input_slots(scene: &Scene) -> Vec<InputSlot> {
+    let mut slots = Vec::new();
+    for j in &scene.joints {
+        if let Some(d) = j.drive.as_ref().filter(|d| d.law.law == "input") {
+            let (what, unit) = match (j.kind, d.kind) {
+                (JointKind::Prismatic, DriveKind::Motion) => ("position", "m"),
+                (JointKind::Prismatic, DriveKind::Effort) => ("force", "N"),
+                (_, DriveKind::Motion) => ("angle", "rad"),
+                (_, DriveKind::Effort) => ("torque", "N.m"),
+            };
+            slots.push(InputSlot {
+                name: format!("{}.drive.{what}", j.name),
+                unit,
+                start: d.law.value.unwrap_or(0.0),
+                description: format!("Drive of joint {}: prescribed {what}", j.name),
+            });
+        }
+    }
+    for l in scene.loads.iter().filter(|l| l.input) {
+        for (what, unit, start) in [
+            ("fx", "N", l.force[0]),
+            ("fy", "N", l.force[1]),
+            ("torque", "N.m", l.torque),
+        ] {
+            slots.push(InputSlot {
+                name: format!("{}.{what}", l.name),
+                unit,
+                start,
+                description: format!("Load {} on {}: {what} (world axes)", l.name, l.frame),
+            });
+        }
+    }
+    slots
+}
+
+/// A point load: world force and torque on a frame, constant or from input slots.
+#[derive(Debug, Clone)]
+pub struct Load {
+    pub name: String,
+    pub frame: usize,
+    pub force: Vector2<f64>,
+    pub torque: f64,
+    /// Input slots of fx, fy, torque.
+    pub inputs: Option<usize>,
+}
+
+/// A scene beam: one body, or k substructures welded tip to root.
+#[derive(Debug, Clone)]
+pub struct BeamGroup {
+    pub name: String,
+    pub bodies: Range<usize>,
+    pub length: f64,
+    pub pinned: bool,
+    pub section: crate::beam::section::Section,
+    /// The material point at mid-span.
+    pub mid: (usize, PointMap),
+}
+
 #[derive(Debug, Clone)]
 pub struct System {
-    pub bodies: Vec<PlanarBeam>,
+    pub bodies: Vec<Body>,
     /// Index of each body's first coordinate in q.
     pub offsets: Vec<usize>,
-    pub welds: Vec<Weld>,
+    pub frames: Vec<Frame>,
+    pub joints: Vec<Joint>,
+    pub loads: Vec<Load>,
+    pub beams: Vec<BeamGroup>,
     pub gravity: Vector2<f64>,
+    /// Current values of the FMU inputs (slot order of [`input_slots`]).
+    pub inputs: Vec<InputValue>,
     n: usize,
+    m: usize,
 }
 
 impl System {
     /// Assembles the system of a validated scene.
     pub fn from_scene(scene: &Scene) -> System {
-        let bodies: Vec<PlanarBeam> = scene.beams.iter().map(PlanarBeam::from_spec).collect();
+        let mut bodies = Vec::new();
+        let mut beams = Vec::new();
+        for spec in &scene.beams {
+            let (elements, k) = Scene::beam_layout(spec);
+            let first = bodies.len();
+            let section = crate::beam::section::Section::from_spec(&spec.section);
+            if spec.rigid {
+                let mass = spec.material.rho * section.area * spec.length;
+                bodies.push(Body::Rigid(RigidBody {
+                    name: spec.name.clone(),
+                    mass,
+                    com: Vector2::new(spec.length / 2.0, 0.0),
+                    inertia: mass * spec.length * spec.length / 12.0,
+                    frames: vec![
+                        ("a".into(), Vector2::zeros()),
+                        ("b".into(), Vector2::new(spec.length, 0.0)),
+                    ],
+                }));
+            } else {
+                let ls = spec.length / k as f64;
+                for i in 0..k {
+                    let name = if k == 1 {
+                        spec.name.clone()
+                    } else {
+                        format!("{}[{i}]", spec.name)
+                    };
+                    let mut b = PlanarBeam::new(
+                        &name,
+                        ls,
+                        elements,
+                        spec.frame,
+                        spec.material.rho,
+                        spec.material.e,
+                        section,
+                        spec.rayleigh.alpha,
+                        spec.rayleigh.beta,
+                    );
+                    b.set_geometric_stiffening(spec.geometric_stiffening);
+                    bodies.push(Body::Beam(Box::new(b)));
+                }
+            }
+            let range = first..bodies.len();
+            // mid-span: x = L/2 lies in substructure floor(k/2) (at its flange a when k is even)
+            let idx = (range.len() / 2).min(range.len() - 1);
+            let mid_body = first + idx;
+            let local_x = spec.length / 2.0 - idx as f64 * spec.length / range.len() as f64;
+            let mid_map = match &bodies[mid_body] {
+                Body::Beam(b) => b.point_map(local_x),
+                Body::Rigid(_) => PointMap {
+                    s0: Vector2::new(local_x, 0.0),
+                    sp: DMatrix::zeros(2, 0),
+                    sphi: DVector::zeros(0),
+                },
+            };
+            beams.push(BeamGroup {
+                name: spec.name.clone(),
+                bodies: range,
+                length: spec.length,
+                pinned: spec.frame == crate::scene::FrameKind::Pinned,
+                section,
+                mid: (mid_body, mid_map),
+            });
+        }
+        for spec in &scene.bodies {
+            bodies.push(Body::Rigid(RigidBody {
+                name: spec.name.clone(),
+                mass: spec.mass,
+                com: Vector2::new(spec.com[0], spec.com[1]),
+                inertia: spec.inertia,
+                frames: spec
+                    .frames
+                    .iter()
+                    .map(|(n, p)| (n.clone(), Vector2::new(p[0], p[1])))
+                    .collect(),
+            }));
+        }
         let mut offsets = Vec::with_capacity(bodies.len());
         let mut n = 0;
         for b in &bodies {
             offsets.push(n);
             n += b.ndof();
         }
-        let frame_of = |name: &str| -> Frame {
-            if name == "world" {
-                return Frame::World {
-                    position: Vector2::zeros(),
-                    angle: 0.0,
-                };
+        let mut sys = System {
+            bodies,
+            offsets,
+            frames: Vec::new(),
+            joints: Vec::new(),
+            loads: Vec::new(),
+            beams,
+            gravity: Vector2::new(scene.world.gravity[0], scene.world.gravity[1]),
+            inputs: input_slots(scene)
+                .iter()
+                .map(|s| InputValue {
+                    value: s.start,
+                    ..Default::default()
+                })
+                .collect(),
+            n,
+            m: 0,
+        };
+        let q0 = sys.placed_coordinates(scene);
+        let v0 = DVector::zeros(n);
+        // substructure welds: flange b of each frame to flange a of the next
+        let mut internal = Vec::new();
+        for g in sys.beams.clone() {
+            for i in g.bodies.start..g.bodies.end.saturating_sub(1) {
+                if let (Body::Beam(b0), Body::Beam(b1)) = (&sys.bodies[i], &sys.bodies[i + 1]) {
+                    let (m0, m1) = (b0.flange_b.clone(), b1.flange_a.clone());
+                    let f0 = sys.add_frame(Frame::OnBody { body: i, map: m0 });
+                    let f1 = sys.add_frame(Frame::OnBody {
+                        body: i + 1,
+                        map: m1,
+                    });
+                    internal.push((
+                        format!("{}.substructure{}", g.name, i + 1 - g.bodies.start),
+                        f0,
+                        f1,
+                    ));
+                }
             }
-            let (beam, flange) = name.rsplit_once('.').unwrap_or((name, "a"));
-            let body = bodies.iter().position(|b| b.name == beam).unwrap_or(0);
-            let map = if flange == "b" {
-                bodies[body].flange_b.clone()
+        }
+        let mut row = 0;
+        for (name, f0, f1) in internal {
+            let offset = sys.relative_angle(f0, f1, &q0, &v0);
+            sys.joints.push(Joint {
+                name,
+                kind: JointKind::Weld,
+                frames: [f0, f1],
+                axis_angle: 0.0,
+                angle_offset: offset,
+                drive: None,
+                row,
+            });
+            row += 3;
+        }
+        let slots = input_slots(scene);
+        for j in &scene.joints {
+            let f0 = sys.frame_by_name(&j.frames[0]);
+            let f1 = sys.frame_by_name(&j.frames[1]);
+            let drive = j.drive.as_ref().map(|d| Drive {
+                kind: d.kind,
+                law: TimeLaw::from_spec(
+                    &d.law,
+                    slots
+                        .iter()
+                        .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
+                ),
+            });
+            let offset = sys.relative_angle(f0, f1, &q0, &v0);
+            let count = Joint::rows_count(j.kind, drive.as_ref());
+            sys.joints.push(Joint {
+                name: j.name.clone(),
+                kind: j.kind,
+                frames: [f0, f1],
+                axis_angle: j.axis_angle,
+                angle_offset: offset,
+                drive,
+                row,
+            });
+            row += count;
+        }
+        sys.m = row;
+        for l in &scene.loads {
+            let frame = sys.frame_by_name(&l.frame);
+            let inputs = l
+                .input
+                .then(|| {
+                    slots
+                        .iter()
+                        .position(|s| s.name == format!("{}.fx", l.name))
+                })
+                .flatten();
+            sys.loads.push(Load {
+                name: l.name.clone(),
+                frame,
+                force: Vector2::new(l.force[0], l.force[1]),
+                torque: l.torque,
+                inputs,
+            });
+        }
+        sys
+    }
+
+    fn add_frame(&mut self, f: Frame) -> usize {
+        self.frames.push(f);
+        self.frames.len() - 1
+    }
+
+    /// Resolves a (validated) frame name of the scene.
+    fn frame_by_name(&mut self, name: &str) -> usize {
+        if name == "world" {
+            return self.add_frame(Frame::World {
+                position: Vector2::zeros(),
+                angle: 0.0,
+            });
+        }
+        let (owner, f) = name.split_once('.').unwrap_or((name, "origin"));
+        let frame = if let Some(g) = self.beams.iter().find(|g| g.name == owner) {
+            let body = if f == "a" {
+                g.bodies.start
             } else {
-                bodies[body].flange_a.clone()
+                g.bodies.end - 1
+            };
+            let map = match &self.bodies[body] {
+                Body::Beam(b) if f == "a" => b.flange_a.clone(),
+                Body::Beam(b) => b.flange_b.clone(),
+                Body::Rigid(r) => r.frame_map(f).expect("validated frame"),
+            };
+            Frame::OnBody { body, map }
+        } else {
+            let body = self
+                .bodies
+                .iter()
+                .position(|b| b.name() == owner)
+                .expect("validated body");
+            let map = match &self.bodies[body] {
+                Body::Rigid(r) => r.frame_map(f).expect("validated frame"),
+                Body::Beam(b) => b.flange_a.clone(),
             };
             Frame::OnBody { body, map }
         };
-        let welds = scene
-            .joints
-            .iter()
-            .map(|j| match j.kind {
-                JointKind::Weld => Weld {
-                    name: j.name.clone(),
-                    frames: [frame_of(&j.frames[0]), frame_of(&j.frames[1])],
-                },
-            })
-            .collect();
-        System {
-            offsets,
-            welds,
-            gravity: Vector2::new(scene.world.gravity[0], scene.world.gravity[1]),
-            n,
-            bodies,
-        }
+        self.add_frame(frame)
+    }
+
+    fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>, v: &DVector<f64>) -> f64 {
+        self.frame_state(f1, q, v).phi - self.frame_state(f0, q, v).phi
     }
 
     /// Number of coordinates.
@@ -86,7 +350,24 @@ impl System {
 
     /// Number of constraint equations.
     pub fn m(&self) -> usize {
-        self.welds.len() * Weld::EQUATIONS
+        self.m
+    }
+
+    /// The largest body length (m): the scale of position errors.
+    pub fn length_scale(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(Body::length_scale)
+            .fold(0.0, f64::max)
+            .max(1e-3)
+    }
+
+    /// The flexible beam that is body `i`, if it is one.
+    pub fn beam(&self, i: usize) -> Option<&PlanarBeam> {
+        match &self.bodies[i] {
+            Body::Beam(b) => Some(b),
+            Body::Rigid(_) => None,
+        }
     }
 
     /// Coordinates of body `i`.
@@ -94,85 +375,128 @@ impl System {
         q.rows(self.offsets[i], self.bodies[i].ndof()).into_owned()
     }
 
-    /// Initial coordinates from the scene: placed frames and the initial deformed shapes.
-    pub fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+    /// Coordinates of the scene's placement, before assembly: frames where the scene puts
+    /// them, substructures in a row along their beam, and the initial deformed shapes.
+    fn placed_coordinates(&self, scene: &Scene) -> DVector<f64> {
         let mut q = DVector::zeros(self.n);
-        for (i, (b, spec)) in self.bodies.iter().zip(&scene.beams).enumerate() {
-            let o = self.offsets[i];
+        for (g, spec) in self.beams.iter().zip(&scene.beams) {
+            let k = g.bodies.len();
+            let (ar, _) = rot(spec.angle);
+            for (i, body) in g.bodies.clone().enumerate() {
+                let o = self.offsets[body];
+                let p = Vector2::new(spec.position[0], spec.position[1])
+                    + ar * Vector2::new(i as f64 * spec.length / k as f64, 0.0);
+                q[o] = p[0];
+                q[o + 1] = p[1];
+                q[o + 2] = spec.angle;
+            }
+        }
+        let first_rigid = self.beams.last().map_or(0, |g| g.bodies.end);
+        for (i, spec) in scene.bodies.iter().enumerate() {
+            let o = self.offsets[first_rigid + i];
             q[o] = spec.position[0];
             q[o + 1] = spec.position[1];
             q[o + 2] = spec.angle;
-            if spec.initial.tip_displacement != 0.0 {
-                let shape = b
-                    .static_tip_shape(spec.initial.tip_displacement)
-                    .ok_or_else(|| EngineError::InitialState {
-                        message: format!(
-                            "beam '{}': no static tip shape (is the tip held by the frame?)",
-                            b.name
-                        ),
-                    })?;
-                q.rows_mut(o + 3, b.nflex()).copy_from(&shape);
+        }
+        q
+    }
+
+    /// Initial coordinates from the scene: placement plus the initial deformed shapes.
+    pub fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+        let mut q = self.placed_coordinates(scene);
+        for (g, spec) in self.beams.iter().zip(&scene.beams) {
+            if spec.initial.tip_displacement == 0.0 {
+                continue;
             }
+            let body = g.bodies.start;
+            let b = self.beam(body).ok_or_else(|| EngineError::InitialState {
+                message: format!("beam '{}' is rigid: it has no initial deformation", g.name),
+            })?;
+            let shape = b
+                .static_tip_shape(spec.initial.tip_displacement)
+                .ok_or_else(|| EngineError::InitialState {
+                    message: format!(
+                        "beam '{}': no static tip shape (is the tip held by the frame?)",
+                        b.name
+                    ),
+                })?;
+            q.rows_mut(self.offsets[body] + 3, b.nflex())
+                .copy_from(&shape);
         }
         Ok(q)
     }
 
-    fn frame_pose(&self, f: &Frame, q: &DVector<f64>) -> (Vector2<f64>, f64) {
-        match f {
-            Frame::World { position, angle } => (*position, *angle),
-            Frame::OnBody { body, map } => {
-                self.bodies[*body].point(map, &self.body_coords(*body, q))
+    /// Kinematics of frame `f`.
+    pub fn frame_state(&self, f: usize, q: &DVector<f64>, v: &DVector<f64>) -> FrameState {
+        match &self.frames[f] {
+            Frame::World { position, angle } => FrameState::world(*position, *angle),
+            Frame::OnBody { body, map } => FrameState::on_body(
+                *body,
+                &self.bodies[*body],
+                map,
+                &self.body_coords(*body, q),
+                &self.body_coords(*body, v),
+            ),
+        }
+    }
+
+    /// The rows of joint `j` at (q, q', t).
+    pub fn joint_rows(
+        &self,
+        j: &Joint,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        t: f64,
+    ) -> (FrameState, FrameState, Vec<Row>) {
+        let f0 = self.frame_state(j.frames[0], q, v);
+        let f1 = self.frame_state(j.frames[1], q, v);
+        let rows = j.rows(&f0, &f1, t, &self.inputs);
+        (f0, f1, rows)
+    }
+
+    /// Constraint residual g(q, t).
+    pub fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
+        let v = DVector::zeros(self.n);
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, &v, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
             }
         }
     }
 
-    /// Constraint residual g(q).
-    pub fn constraints(&self, q: &DVector<f64>, g: &mut DVector<f64>) {
-        for (k, w) in self.welds.iter().enumerate() {
-            let (p0, a0) = self.frame_pose(&w.frames[0], q);
-            let (p1, a1) = self.frame_pose(&w.frames[1], q);
-            g[3 * k] = p0[0] - p1[0];
-            g[3 * k + 1] = p0[1] - p1[1];
-            g[3 * k + 2] = a0 - a1;
+    fn add_row_jacobian(
+        &self,
+        out: &mut DMatrix<f64>,
+        row: usize,
+        f: &FrameState,
+        jac: &DVector<f64>,
+    ) {
+        if let Some(b) = f.body {
+            let mut dst = out.view_mut((row, self.offsets[b]), (1, jac.len()));
+            dst += jac.transpose();
         }
     }
 
     /// Constraint Jacobian G = ∂g/∂q (m × n), overwritten.
-    pub fn constraint_jacobian(&self, q: &DVector<f64>, g: &mut DMatrix<f64>) {
+    pub fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
         g.fill(0.0);
-        for (k, w) in self.welds.iter().enumerate() {
-            for (f, sign) in w.frames.iter().zip([1.0, -1.0]) {
-                if let Frame::OnBody { body, map } = f {
-                    let b = &self.bodies[*body];
-                    let z = self.body_coords(*body, q);
-                    frame::add_jacobian(
-                        b,
-                        map,
-                        &z,
-                        sign,
-                        g.view_mut((3 * k, self.offsets[*body]), (3, b.ndof())),
-                    );
-                }
+        let v = DVector::zeros(self.n);
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, &v, t);
+            for (k, r) in rows.iter().enumerate() {
+                self.add_row_jacobian(g, j.row + k, &f0, &r.j0);
+                self.add_row_jacobian(g, j.row + k, &f1, &r.j1);
             }
         }
     }
 
     /// Acceleration bias: d²g/dt² = G q'' + bias.
-    pub fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, out: &mut DVector<f64>) {
-        out.fill(0.0);
-        for (k, w) in self.welds.iter().enumerate() {
-            for (f, sign) in w.frames.iter().zip([1.0, -1.0]) {
-                if let Frame::OnBody { body, map } = f {
-                    let b = &self.bodies[*body];
-                    let bias = frame::accel_bias(
-                        b,
-                        map,
-                        &self.body_coords(*body, q),
-                        &self.body_coords(*body, v),
-                    );
-                    out[3 * k] += sign * bias[0];
-                    out[3 * k + 1] += sign * bias[1];
-                }
+    pub fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, v, t);
+            for (k, r) in rows.iter().enumerate() {
+                out[j.row + k] = r.bias;
             }
         }
     }
@@ -189,12 +513,44 @@ impl System {
         }
     }
 
-    /// Residual r(q, q', q'') without the reactions, overwritten.
+    /// Force and torque of load `l` at time t.
+    fn load_value(&self, l: &Load, t: f64) -> (Vector2<f64>, f64) {
+        let _ = t;
+        match l.inputs {
+            Some(s) => (
+                Vector2::new(self.input_at(s, t), self.input_at(s + 1, t)),
+                self.input_at(s + 2, t),
+            ),
+            None => (l.force, l.torque),
+        }
+    }
+
+    fn input_at(&self, slot: usize, t: f64) -> f64 {
+        let u = self.inputs[slot];
+        let dt = t - u.t0;
+        u.value + u.der1 * dt + 0.5 * u.der2 * dt * dt
+    }
+
+    fn add_generalized_force(
+        &self,
+        r: &mut DVector<f64>,
+        f: &FrameState,
+        gen: &DVector<f64>,
+        scale: f64,
+    ) {
+        if let Some(b) = f.body {
+            let mut dst = r.rows_mut(self.offsets[b], gen.len());
+            dst.axpy(-scale, gen, 1.0);
+        }
+    }
+
+    /// Residual r(q, q', q'', t) without the reactions: inertia + internal - applied, overwritten.
     pub fn body_residual(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
+        t: f64,
         r: &mut DVector<f64>,
     ) {
         r.fill(0.0);
@@ -209,15 +565,53 @@ impl System {
                 &mut r.as_mut_slice()[o..o + n],
             );
         }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, v);
+            let (force, torque) = self.load_value(l, t);
+            let gen = fs.jp.tr_mul(&force) + &fs.jphi * torque;
+            self.add_generalized_force(r, &fs, &gen, 1.0);
+        }
+        for j in &self.joints {
+            if let Some(effort) = j.effort(t, &self.inputs) {
+                let f0 = self.frame_state(j.frames[0], q, v);
+                let f1 = self.frame_state(j.frames[1], q, v);
+                let c = j.coordinate(&f0, &f1);
+                self.add_generalized_force(r, &f0, &c.j0, effort);
+                self.add_generalized_force(r, &f1, &c.j1, effort);
+            }
+        }
     }
 
-    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q', overwritten.
+    fn add_force_tangent(
+        &self,
+        kt: &mut DMatrix<f64>,
+        frame: usize,
+        q: &DVector<f64>,
+        force: Vector2<f64>,
+    ) {
+        if let Frame::OnBody { body, map } = &self.frames[frame] {
+            let b = &self.bodies[*body];
+            let o = self.offsets[*body];
+            frame::add_force_tangent(
+                b,
+                map,
+                &self.body_coords(*body, q),
+                force,
+                kt.view_mut((o, o), (b.ndof(), b.ndof())),
+            );
+        }
+    }
+
+    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q', overwritten. The terms from the
+    /// rotation of a prismatic axis and of effort drives are left out (Newton converges
+    /// without them).
     pub fn tangents(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
         lambda: &DVector<f64>,
+        t: f64,
         kt: &mut DMatrix<f64>,
         ct: &mut DMatrix<f64>,
     ) {
@@ -235,21 +629,19 @@ impl System {
                 ct.view_mut((o, o), (n, n)),
             );
         }
-        for (k, w) in self.welds.iter().enumerate() {
-            let lp = Vector2::new(lambda[3 * k], lambda[3 * k + 1]);
-            for (f, sign) in w.frames.iter().zip([1.0, -1.0]) {
-                if let Frame::OnBody { body, map } = f {
-                    let b = &self.bodies[*body];
-                    let o = self.offsets[*body];
-                    frame::add_reaction_tangent(
-                        b,
-                        map,
-                        &self.body_coords(*body, q),
-                        lp * sign,
-                        kt.view_mut((o, o), (b.ndof(), b.ndof())),
-                    );
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, v, t);
+            for (k, r) in rows.iter().enumerate() {
+                if let Some(d) = r.force_dir {
+                    let l = lambda[j.row + k];
+                    self.add_force_tangent(kt, j.frames[1], q, d * l);
+                    self.add_force_tangent(kt, j.frames[0], q, -d * l);
                 }
             }
+        }
+        for l in &self.loads {
+            let (force, _) = self.load_value(l, t);
+            self.add_force_tangent(kt, l.frame, q, -force);
         }
     }
 
@@ -267,11 +659,121 @@ impl System {
 
     /// Names of the joints whose equations are in the given constraint rows.
     pub fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
-        let mut names: Vec<String> = rows
-            .iter()
-            .map(|r| self.welds[r / Weld::EQUATIONS].name.clone())
-            .collect();
-        names.dedup();
+        let mut names: Vec<String> = Vec::new();
+        for &r in rows {
+            if let Some(j) = self.joints.iter().rev().find(|j| j.row <= r) {
+                if !names.contains(&j.name) {
+                    names.push(j.name.clone());
+                }
+            }
+        }
         names
     }
+
+    /// Times where a drive law jumps, for the integrator to land on.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self
+            .joints
+            .iter()
+            .filter_map(|j| j.drive.as_ref())
+            .flat_map(|d| d.law.breakpoints())
+            .collect();
+        b.sort_by(|x, y| x.total_cmp(y));
+        b.dedup();
+        b
+    }
+
+    /// Joint coordinate (rad or m) and its rate.
+    pub fn joint_coordinate(&self, j: usize, q: &DVector<f64>, v: &DVector<f64>) -> (f64, f64) {
+        let jt = &self.joints[j];
+        let f0 = self.frame_state(jt.frames[0], q, v);
+        let f1 = self.frame_state(jt.frames[1], q, v);
+        let c = jt.coordinate(&f0, &f1);
+        let body_rate = |f: &FrameState, jac: &DVector<f64>| {
+            f.body.map_or(0.0, |b| jac.dot(&self.body_coords(b, v)))
+        };
+        (c.g, body_rate(&f0, &c.j0) + body_rate(&f1, &c.j1))
+    }
+
+    /// Torque (revolute) or force (prismatic) that the joint's drive applies across the joint:
+    /// the effort law, or the reaction of a motion drive (-λ of its row); 0 without a drive.
+    pub fn joint_effort(&self, j: usize, lambda: &DVector<f64>, t: f64) -> f64 {
+        let jt = &self.joints[j];
+        match jt.drive.as_ref().map(|d| d.kind) {
+            Some(DriveKind::Effort) => jt.effort(t, &self.inputs).unwrap_or(0.0),
+            Some(DriveKind::Motion) => {
+                let row = jt.row + Joint::rows_count(jt.kind, jt.drive.as_ref()) - 1;
+                -lambda[row]
+            }
+            None => 0.0,
+        }
+    }
+
+    /// Power of drives and loads (W): Σ effort × joint rate + Σ F·ṗ + τ φ̇.
+    pub fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
+        let mut p = 0.0;
+        for (j, jt) in self.joints.iter().enumerate() {
+            if jt.drive.is_some() {
+                p += self.joint_effort(j, lambda, t) * self.joint_coordinate(j, q, v).1;
+            }
+        }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, v);
+            let (force, torque) = self.load_value(l, t);
+            p += force.dot(&fs.pd) + torque * fs.phid;
+        }
+        p
+    }
+
+    /// Index of the scene joint `name` in `joints`.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// World position and angle of the tip (flange b) of beam group `g`, and of its root frame.
+    pub fn beam_tip(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let grp = &self.beams[g];
+        let last = grp.bodies.end - 1;
+        let z = self.body_coords(last, q);
+        match &self.bodies[last] {
+            Body::Beam(b) => b.point(&b.flange_b, &z),
+            Body::Rigid(r) => r_point(r, "b", &z),
+        }
+    }
+
+    /// Transverse displacement of a world point from the beam's root axis (or, for a pinned
+    /// frame, from the chord flange a → flange b).
+    pub fn beam_transverse(&self, g: usize, q: &DVector<f64>, p: Vector2<f64>) -> f64 {
+        let grp = &self.beams[g];
+        let z0 = self.body_coords(grp.bodies.start, q);
+        let root = Vector2::new(z0[0], z0[1]);
+        let axis = if grp.pinned {
+            let (tip, _) = self.beam_tip(g, q);
+            let d = tip - root;
+            if d.norm() > 0.0 {
+                d / d.norm()
+            } else {
+                Vector2::x()
+            }
+        } else {
+            let (s, c) = z0[2].sin_cos();
+            Vector2::new(c, s)
+        };
+        let d = p - root;
+        axis.x * d.y - axis.y * d.x
+    }
+
+    /// World position of the beam's mid-span point.
+    pub fn beam_mid(&self, g: usize, q: &DVector<f64>) -> Vector2<f64> {
+        let (body, map) = &self.beams[g].mid;
+        self.bodies[*body].point(map, &self.body_coords(*body, q)).0
+    }
+}
+
+fn r_point(r: &RigidBody, frame: &str, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+    let map = r
+        .frame_map(frame)
+        .unwrap_or_else(|| r.frame_map("origin").expect("origin"));
+    let (ar, _) = rot(z[2]);
+    (Vector2::new(z[0], z[1]) + ar * map.s0, z[2])
 }

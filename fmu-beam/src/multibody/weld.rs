@@ -1,16 +1,13 @@
-//! The weld joint: two frames keep the same position and angle (3 equations).
-//! Flange a of a beam welded to the world is the clamp of case C1.
+//! The weld joint: two frames keep their relative position and angle (3 equations).
+//! Flange a of a beam welded to the world is the clamp of case C1; substructures of a beam are
+//! welded tip to root (planar paper §3.4).
 
-use super::frame::Frame;
+use super::frame::FrameState;
+use super::joint::Row;
 
-/// A rigid connection between two frames; g = [p₀ - p₁; φ₀ - φ₁] = 0.
-#[derive(Debug, Clone)]
-pub struct Weld {
-    pub name: String,
-    pub frames: [Frame; 2],
-}
-
-impl Weld {
-    /// Number of constraint equations.
-    pub const EQUATIONS: usize = 3;
+/// g = [p₁ - p₀; φ₁ - φ₀ - offset].
+pub fn rows(f0: &FrameState, f1: &FrameState, offset: f64) -> Vec<Row> {
+    let mut rows = super::revolute::rows(f0, f1);
+    rows.push(Row::angle(f0, f1, offset));
+    rows
 }

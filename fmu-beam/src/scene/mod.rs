@@ -27,8 +27,12 @@ pub struct Scene {
     pub experiment: ExperimentSpec,
     #[serde(default, rename = "beam")]
     pub beams: Vec<BeamSpec>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<RigidBodySpec>,
     #[serde(default, rename = "joint")]
     pub joints: Vec<JointSpec>,
+    #[serde(default, rename = "load")]
+    pub loads: Vec<LoadSpec>,
 }
 
 /// The world: its gravity field (m/s^2, world axes).
@@ -118,8 +122,21 @@ pub struct BeamSpec {
     pub name: String,
     /// Undeformed length (m).
     pub length: f64,
-    /// Number of finite elements N.
-    pub elements: usize,
+    /// Number of finite elements N of a single-frame beam.
+    #[serde(default)]
+    pub elements: Option<usize>,
+    /// Number of substructures k (planar paper §3.4): k floating frames welded tip to root.
+    #[serde(default)]
+    pub substructures: Option<usize>,
+    /// Elements in each substructure (with `substructures`).
+    #[serde(default)]
+    pub elements_per_substructure: Option<usize>,
+    /// A rigid bar instead of a flexible beam (same mass and inertia, no deformation).
+    #[serde(default)]
+    pub rigid: bool,
+    /// Adds the geometric stiffness of the axial force (nonlinear strain u' + v'^2/2).
+    #[serde(default)]
+    pub geometric_stiffening: bool,
     /// Reference frame of the deformation field (planar paper §3.3).
     #[serde(default)]
     pub frame: FrameKind,
@@ -141,7 +158,13 @@ pub struct BeamSpec {
 }
 
 /// The outputs a beam can offer, by their name after `<beam>.`.
-pub const BEAM_OUTPUTS: [&str; 4] = ["tip.deflection", "tip.x", "tip.y", "tip.phi"];
+pub const BEAM_OUTPUTS: [&str; 5] = [
+    "tip.deflection",
+    "tip.x",
+    "tip.y",
+    "tip.phi",
+    "mid.deflection",
+];
 
 /// Reference frame conventions of the planar paper §3.3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -211,15 +234,43 @@ pub struct InitialSpec {
     pub tip_displacement: f64,
 }
 
-/// A joint between two frames, named `world` or `<beam>.a` / `<beam>.b`.
+/// A planar rigid body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodySpec {
+    pub name: String,
+    /// Mass (kg); zero is allowed when joints fix every coordinate of the body.
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass (kg m^2).
+    #[serde(default)]
+    pub inertia: f64,
+    /// Centre of mass in the body frame (m).
+    #[serde(default)]
+    pub com: [f64; 2],
+    /// World position (m) and angle (rad) of the body frame at t = 0.
+    #[serde(default)]
+    pub position: [f64; 2],
+    #[serde(default)]
+    pub angle: f64,
+    /// Named frames (positions in the body frame); `origin` and `com` always exist.
+    #[serde(default)]
+    pub frames: std::collections::BTreeMap<String, [f64; 2]>,
+}
+
+/// A joint between two frames: `world`, `<beam>.a`, `<beam>.b`, `<body>.<frame>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointSpec {
     pub name: String,
     #[serde(rename = "type")]
     pub kind: JointKind,
-    /// The two frames the joint connects.
+    /// The two frames the joint connects; a prismatic joint slides along the x axis of the
+    /// first, turned by `axis_angle`.
     pub frames: [String; 2],
+    #[serde(default)]
+    pub axis_angle: f64,
+    #[serde(default)]
+    pub drive: Option<DriveSpec>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -227,6 +278,66 @@ pub struct JointSpec {
 pub enum JointKind {
     /// Rigid connection: position and angle of the two frames coincide.
     Weld,
+    /// Same position, free relative rotation.
+    Revolute,
+    /// Same angle, free sliding along an axis.
+    Prismatic,
+}
+
+/// What drives a revolute or prismatic joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSpec {
+    /// `motion` (the joint coordinate follows the law), or `effort` (a torque, or a force for a
+    /// prismatic joint, acts across the joint).
+    pub kind: DriveKind,
+    #[serde(flatten)]
+    pub law: LawSpec,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DriveKind {
+    Motion,
+    Effort,
+}
+
+/// A scalar function of time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LawSpec {
+    /// `constant`, `exponential` (value (1 - exp(-t/time_constant))), `spin_up` (planar paper
+    /// eq. (18) with `omega` and `ramp_time`), `table` (piecewise linear), `input` (an FMU input).
+    pub law: String,
+    #[serde(default)]
+    pub value: Option<f64>,
+    #[serde(default)]
+    pub time_constant: Option<f64>,
+    /// The law is zero after this time (s).
+    #[serde(default)]
+    pub until: Option<f64>,
+    #[serde(default)]
+    pub omega: Option<f64>,
+    #[serde(default)]
+    pub ramp_time: Option<f64>,
+    /// Rows [t, value], t increasing.
+    #[serde(default)]
+    pub table: Option<Vec<[f64; 2]>>,
+}
+
+/// A point force (world axes) and torque on a frame, constant or FMU inputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    pub name: String,
+    pub frame: String,
+    #[serde(default)]
+    pub force: [f64; 2],
+    #[serde(default)]
+    pub torque: f64,
+    /// Offer `<load>.fx`, `<load>.fy`, `<load>.torque` as FMU inputs (start: the values above).
+    #[serde(default)]
+    pub input: bool,
 }
 
 impl Scene {
@@ -253,6 +364,14 @@ impl Scene {
     /// The canonical TOML text of this scene (what the packager writes into the FMU).
     pub fn to_toml_string(&self) -> String {
         toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Elements per floating frame and number of frames of a (validated) beam.
+    pub fn beam_layout(beam: &BeamSpec) -> (usize, usize) {
+        match beam.substructures {
+            Some(k) => (beam.elements_per_substructure.unwrap_or(1), k),
+            None => (beam.elements.unwrap_or(1), 1),
+        }
     }
 
     pub fn beam(&self, name: &str) -> Option<&BeamSpec> {

@@ -1,6 +1,9 @@
 //! Value rules of a scene. Each error names the file, the field and the rule.
 
-use super::{BeamSpec, FrameKind, Scene, SectionSpec, BEAM_OUTPUTS};
+use super::{
+    BeamSpec, DriveKind, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene, SectionSpec,
+    BEAM_OUTPUTS,
+};
 use thiserror::Error;
 
 /// Why a scene was refused.
@@ -115,30 +118,58 @@ impl Scene {
                 ));
             }
         }
+        for (i, b) in self.bodies.iter().enumerate() {
+            validate_body(&ck, b, i)?;
+        }
+        let mut names: Vec<(&str, String)> = Vec::new();
+        let all = self
+            .beams
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (&b.name, format!("beam[{i}].name")))
+            .chain(
+                self.bodies
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| (&b.name, format!("body[{i}].name"))),
+            )
+            .chain(
+                self.joints
+                    .iter()
+                    .enumerate()
+                    .map(|(i, j)| (&j.name, format!("joint[{i}].name"))),
+            )
+            .chain(
+                self.loads
+                    .iter()
+                    .enumerate()
+                    .map(|(i, l)| (&l.name, format!("load[{i}].name"))),
+            );
+        for (name, field) in all {
+            if !is_identifier(name) || name == "world" || name == "solver" || name == "energy" {
+                return Err(ck.fail(
+                    &field,
+                    format!("{name:?}"),
+                    "must be an identifier (letters, digits, _; not starting with a digit) other than world, solver, energy",
+                ));
+            }
+            if names.iter().any(|(n, _)| *n == name.as_str()) {
+                return Err(ck.fail(
+                    &field,
+                    format!("{name:?}"),
+                    "names of beams, bodies, joints and loads must be unique",
+                ));
+            }
+            names.push((name, field));
+        }
         for (i, j) in self.joints.iter().enumerate() {
             let field = format!("joint[{i}]");
-            if !is_identifier(&j.name) {
-                return Err(ck.fail(
-                    &format!("{field}.name"),
-                    format!("{:?}", j.name),
-                    "must be an identifier (letters, digits, _; not starting with a digit)",
-                ));
-            }
-            if self.beams.iter().any(|b| b.name == j.name)
-                || self.joints[..i].iter().any(|o| o.name == j.name)
-            {
-                return Err(ck.fail(
-                    &format!("{field}.name"),
-                    format!("{:?}", j.name),
-                    "names of beams and joints must be unique",
-                ));
-            }
             for (k, f) in j.frames.iter().enumerate() {
                 if !self.frame_exists(f) {
                     return Err(ck.fail(
                         &format!("{field}.frames[{k}]"),
                         format!("{f:?}"),
-                        "must be `world` or `<beam>.a` / `<beam>.b` of a beam in this scene",
+                        "must be `world`, `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
                     ));
                 }
             }
@@ -149,6 +180,44 @@ impl Scene {
                     "a joint connects two different frames",
                 ));
             }
+            ck.finite(&format!("{field}.axis_angle"), j.axis_angle)?;
+            if let Some(d) = &j.drive {
+                if j.kind == JointKind::Weld {
+                    return Err(ck.fail(
+                        &format!("{field}.drive"),
+                        format!("{:?}", d.kind),
+                        "a weld joint has no motion to drive",
+                    ));
+                }
+                validate_law(&ck, &d.law, &format!("{field}.drive"))?;
+                if d.kind == DriveKind::Motion && matches!(d.law.law.as_str(), "exponential") {
+                    return Err(ck.fail(
+                        &format!("{field}.drive.law"),
+                        "\"exponential\"",
+                        "a motion drive needs a law with a continuous start (constant, spin_up, table, input)",
+                    ));
+                }
+            }
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            let field = format!("load[{i}]");
+            if !self.frame_exists(&l.frame) {
+                return Err(ck.fail(
+                    &format!("{field}.frame"),
+                    format!("{:?}", l.frame),
+                    "must be `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
+                ));
+            }
+            if l.frame == "world" {
+                return Err(ck.fail(
+                    &format!("{field}.frame"),
+                    "\"world\"",
+                    "a load acts on a body",
+                ));
+            }
+            ck.finite(&format!("{field}.force[0]"), l.force[0])?;
+            ck.finite(&format!("{field}.force[1]"), l.force[1])?;
+            ck.finite(&format!("{field}.torque"), l.torque)?;
         }
         Ok(())
     }
@@ -157,9 +226,12 @@ impl Scene {
         if frame == "world" {
             return true;
         }
-        match frame.rsplit_once('.') {
-            Some((beam, "a" | "b")) => self.beams.iter().any(|b| b.name == beam),
-            _ => false,
+        match frame.split_once('.') {
+            Some((beam, "a" | "b")) if self.beams.iter().any(|b| b.name == beam) => true,
+            Some((body, f)) => self.bodies.iter().any(|b| {
+                b.name == body && (f == "origin" || f == "com" || b.frames.contains_key(f))
+            }),
+            None => false,
         }
     }
 }
@@ -174,11 +246,60 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError>
         ));
     }
     ck.positive(&f("length"), b.length)?;
-    if b.elements == 0 {
-        return Err(ck.fail(&f("elements"), b.elements, "must be at least 1"));
+    let count = |field: &str, n: usize, max: usize| -> Result<(), SceneError> {
+        if n == 0 {
+            return Err(ck.fail(&f(field), n, "must be at least 1"));
+        }
+        if n > max {
+            return Err(ck.fail(&f(field), n, &format!("must be at most {max}")));
+        }
+        Ok(())
+    };
+    match (b.elements, b.substructures, b.elements_per_substructure) {
+        (Some(n), None, None) => count("elements", n, 2000)?,
+        (None, Some(k), Some(n)) => {
+            count("substructures", k, 500)?;
+            count("elements_per_substructure", n, 2000)?;
+        }
+        (None, None, _) => {
+            return Err(ck.fail(
+                &f("elements"),
+                "missing",
+                "give `elements`, or `substructures` with `elements_per_substructure`",
+            ))
+        }
+        (None, Some(_), None) => {
+            return Err(ck.fail(
+                &f("elements_per_substructure"),
+                "missing",
+                "is required with `substructures`",
+            ))
+        }
+        (Some(n), Some(_), _) | (Some(n), None, Some(_)) => {
+            return Err(ck.fail(
+                &f("elements"),
+                n,
+                "give either `elements` (one frame) or `substructures` with `elements_per_substructure`",
+            ))
+        }
     }
-    if b.elements > 2000 {
-        return Err(ck.fail(&f("elements"), b.elements, "must be at most 2000"));
+    if b.substructures.is_some() && b.initial.tip_displacement != 0.0 {
+        return Err(ck.fail(
+            &f("initial.tip_displacement"),
+            b.initial.tip_displacement,
+            "is only available for single-frame beams (`elements`)",
+        ));
+    }
+    if b.rigid
+        && (b.substructures.is_some()
+            || b.geometric_stiffening
+            || b.initial.tip_displacement != 0.0)
+    {
+        return Err(ck.fail(
+            &f("rigid"),
+            true,
+            "a rigid beam has no substructures, stiffening or initial deformation",
+        ));
     }
     ck.positive(&f("material.rho"), b.material.rho)?;
     ck.positive(&f("material.E"), b.material.e)?;
@@ -302,6 +423,93 @@ fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), Sc
                     ))
                 }
             }
+        }
+    }
+    Ok(())
+}
+
+fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize) -> Result<(), SceneError> {
+    let f = |name: &str| format!("body[{i}].{name}");
+    ck.non_negative(&f("mass"), b.mass)?;
+    ck.non_negative(&f("inertia"), b.inertia)?;
+    for k in 0..2 {
+        ck.finite(&f(&format!("com[{k}]")), b.com[k])?;
+        ck.finite(&f(&format!("position[{k}]")), b.position[k])?;
+    }
+    ck.finite(&f("angle"), b.angle)?;
+    for (name, p) in &b.frames {
+        if !is_identifier(name) || name == "a" || name == "b" {
+            return Err(ck.fail(
+                &f(&format!("frames.{name}")),
+                format!("{name:?}"),
+                "frame names are identifiers other than a and b",
+            ));
+        }
+        ck.finite(&f(&format!("frames.{name}[0]")), p[0])?;
+        ck.finite(&f(&format!("frames.{name}[1]")), p[1])?;
+    }
+    Ok(())
+}
+
+fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{field}.{name}");
+    let need = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
+        let x = v.ok_or_else(|| {
+            ck.fail(
+                &f(name),
+                "missing",
+                &format!("is required by law \"{}\"", l.law),
+            )
+        })?;
+        ck.finite(&f(name), x)?;
+        Ok(x)
+    };
+    if let Some(u) = l.until {
+        ck.non_negative(&f("until"), u)?;
+    }
+    match l.law.as_str() {
+        "constant" => {
+            need(l.value, "value")?;
+        }
+        "exponential" => {
+            need(l.value, "value")?;
+            ck.positive(&f("time_constant"), need(l.time_constant, "time_constant")?)?;
+        }
+        "spin_up" => {
+            need(l.omega, "omega")?;
+            ck.positive(&f("ramp_time"), need(l.ramp_time, "ramp_time")?)?;
+        }
+        "table" => {
+            let t = l
+                .table
+                .as_ref()
+                .ok_or_else(|| ck.fail(&f("table"), "missing", "is required by law \"table\""))?;
+            if t.len() < 2 {
+                return Err(ck.fail(&f("table"), t.len(), "needs at least two rows [t, value]"));
+            }
+            for (k, row) in t.iter().enumerate() {
+                ck.finite(&f(&format!("table[{k}][0]")), row[0])?;
+                ck.finite(&f(&format!("table[{k}][1]")), row[1])?;
+                if k > 0 && row[0] <= t[k - 1][0] {
+                    return Err(ck.fail(
+                        &f(&format!("table[{k}][0]")),
+                        row[0],
+                        "times must increase",
+                    ));
+                }
+            }
+        }
+        "input" => {
+            if let Some(v) = l.value {
+                ck.finite(&f("value"), v)?;
+            }
+        }
+        other => {
+            return Err(ck.fail(
+                &f("law"),
+                format!("{other:?}"),
+                "must be one of constant, exponential, spin_up, table, input",
+            ))
         }
     }
     Ok(())

@@ -1,0 +1,124 @@
+//! A body of the system: a flexible beam (one floating frame) or a rigid body. Both share the
+//! floating-frame kinematics r = R + A(θ) (s0 + S_p q_f); a rigid body has no q_f.
+
+use super::rigid_body::RigidBody;
+use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, FLEX, THETA};
+use nalgebra::{DMatrixViewMut, DVector, Vector2};
+
+#[derive(Debug, Clone)]
+pub enum Body {
+    Beam(Box<PlanarBeam>),
+    Rigid(RigidBody),
+}
+
+impl Body {
+    pub fn name(&self) -> &str {
+        match self {
+            Body::Beam(b) => &b.name,
+            Body::Rigid(r) => &r.name,
+        }
+    }
+
+    pub fn ndof(&self) -> usize {
+        FLEX + self.nflex()
+    }
+
+    pub fn nflex(&self) -> usize {
+        match self {
+            Body::Beam(b) => b.nflex(),
+            Body::Rigid(_) => 0,
+        }
+    }
+
+    /// Characteristic length (m) for error weights.
+    pub fn length_scale(&self) -> f64 {
+        match self {
+            Body::Beam(b) => b.length,
+            Body::Rigid(r) => r
+                .frames
+                .iter()
+                .map(|(_, p)| p.norm())
+                .fold(r.com.norm(), f64::max),
+        }
+    }
+
+    /// True for coordinates that are angles (θ, nodal slopes); false for lengths.
+    pub fn is_angle(&self, k: usize) -> bool {
+        match self {
+            Body::Beam(b) => k == THETA || (k >= FLEX && b.kept[k - FLEX] % 3 == 2),
+            Body::Rigid(_) => k == THETA,
+        }
+    }
+
+    pub fn mass_matrix(&self, z: &DVector<f64>, m: DMatrixViewMut<f64>) {
+        match self {
+            Body::Beam(b) => b.mass_matrix(z, m),
+            Body::Rigid(r) => r.mass_matrix(z, m),
+        }
+    }
+
+    pub fn residual(
+        &self,
+        z: &DVector<f64>,
+        zd: &DVector<f64>,
+        zdd: &DVector<f64>,
+        g: Vector2<f64>,
+        out: &mut [f64],
+    ) {
+        match self {
+            Body::Beam(b) => b.residual(z, zd, zdd, g, out),
+            Body::Rigid(r) => r.residual(z, zd, zdd, g, out),
+        }
+    }
+
+    pub fn tangents(
+        &self,
+        z: &DVector<f64>,
+        zd: &DVector<f64>,
+        zdd: &DVector<f64>,
+        g: Vector2<f64>,
+        kt: DMatrixViewMut<f64>,
+        ct: DMatrixViewMut<f64>,
+    ) {
+        match self {
+            Body::Beam(b) => b.tangents(z, zd, zdd, g, kt, ct),
+            Body::Rigid(r) => r.tangents(z, zd, zdd, g, kt, ct),
+        }
+    }
+
+    pub fn kinetic_energy(&self, z: &DVector<f64>, zd: &DVector<f64>) -> f64 {
+        match self {
+            Body::Beam(b) => b.kinetic_energy(z, zd),
+            Body::Rigid(r) => r.kinetic_energy(z, zd),
+        }
+    }
+
+    pub fn strain_energy(&self, z: &DVector<f64>) -> f64 {
+        match self {
+            Body::Beam(b) => b.strain_energy(z),
+            Body::Rigid(_) => 0.0,
+        }
+    }
+
+    pub fn gravity_energy(&self, z: &DVector<f64>, g: Vector2<f64>) -> f64 {
+        match self {
+            Body::Beam(b) => b.gravity_energy(z, g),
+            Body::Rigid(r) => r.gravity_energy(z, g),
+        }
+    }
+
+    /// Position of a material point in the body frame, s = s0 + S_p q_f.
+    pub fn local_point(&self, map: &PointMap, z: &DVector<f64>) -> Vector2<f64> {
+        map.s0 + &map.sp * z.rows(FLEX, self.nflex())
+    }
+
+    /// World position and angle of a material point.
+    pub fn point(&self, map: &PointMap, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let (ar, _) = rot(z[THETA]);
+        let s = self.local_point(map, z);
+        (
+            Vector2::new(z[0], z[1]) + ar * s,
+            z[THETA] + map.sphi.dot(&z.rows(FLEX, self.nflex())),
+        )
+    }
+}

@@ -1,0 +1,186 @@
+//! Scalar time laws of drives: value and first two time derivatives.
+
+use crate::scene::LawSpec;
+use std::f64::consts::PI;
+
+/// An FMU input held over a communication step, or extrapolated from the derivatives the master
+/// set with fmi2SetRealInputDerivatives: u(t) = u0 + u1 (t - t0) + u2 (t - t0)^2 / 2.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InputValue {
+    pub value: f64,
+    pub der1: f64,
+    pub der2: f64,
+    pub t0: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Law {
+    Constant(f64),
+    /// value (1 - exp(-t/tau)), zero after `until`.
+    Exponential {
+        value: f64,
+        tau: f64,
+    },
+    /// Planar paper eq. (18).
+    SpinUp {
+        omega: f64,
+        ramp: f64,
+    },
+    Table(Vec<[f64; 2]>),
+    /// The FMU input in slot `slot` of the system's inputs.
+    Input(usize),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeLaw {
+    pub law: Law,
+    /// The law is zero from this time on.
+    pub until: Option<f64>,
+}
+
+impl TimeLaw {
+    /// Builds a validated law; `slot` is the input slot for law "input".
+    pub fn from_spec(spec: &LawSpec, slot: Option<usize>) -> TimeLaw {
+        let v = spec.value.unwrap_or(0.0);
+        let law = match spec.law.as_str() {
+            "exponential" => Law::Exponential {
+                value: v,
+                tau: spec.time_constant.unwrap_or(1.0),
+            },
+            "spin_up" => Law::SpinUp {
+                omega: spec.omega.unwrap_or(0.0),
+                ramp: spec.ramp_time.unwrap_or(1.0),
+            },
+            "table" => Law::Table(spec.table.clone().unwrap_or_default()),
+            "input" => Law::Input(slot.unwrap_or(0)),
+            _ => Law::Constant(v),
+        };
+        TimeLaw {
+            law,
+            until: spec.until,
+        }
+    }
+
+    /// (f(t), f'(t), f''(t)).
+    pub fn eval(&self, t: f64, inputs: &[InputValue]) -> (f64, f64, f64) {
+        if self.until.is_some_and(|u| t > u) {
+            return (0.0, 0.0, 0.0);
+        }
+        match &self.law {
+            Law::Constant(v) => (*v, 0.0, 0.0),
+            Law::Exponential { value, tau } => {
+                let e = (-t / tau).exp();
+                (value * (1.0 - e), value * e / tau, -value * e / (tau * tau))
+            }
+            Law::SpinUp { omega, ramp } => {
+                if t < *ramp {
+                    let w = 2.0 * PI / ramp;
+                    let c = (ramp / (2.0 * PI)).powi(2);
+                    (
+                        omega / ramp * (t * t / 2.0 + c * ((w * t).cos() - 1.0)),
+                        omega / ramp * (t - (w * t).sin() / w),
+                        omega / ramp * (1.0 - (w * t).cos()),
+                    )
+                } else {
+                    (omega * (t - ramp / 2.0), *omega, 0.0)
+                }
+            }
+            Law::Table(rows) => {
+                let last = rows.len() - 1;
+                if t <= rows[0][0] {
+                    return (rows[0][1], 0.0, 0.0);
+                }
+                if t >= rows[last][0] {
+                    return (rows[last][1], 0.0, 0.0);
+                }
+                let k = rows.partition_point(|r| r[0] <= t).max(1);
+                let (a, b) = (rows[k - 1], rows[k]);
+                let slope = (b[1] - a[1]) / (b[0] - a[0]);
+                (a[1] + slope * (t - a[0]), slope, 0.0)
+            }
+            Law::Input(slot) => {
+                let u = inputs.get(*slot).copied().unwrap_or_default();
+                let dt = t - u.t0;
+                (
+                    u.value + u.der1 * dt + 0.5 * u.der2 * dt * dt,
+                    u.der1 + u.der2 * dt,
+                    u.der2,
+                )
+            }
+        }
+    }
+
+    /// Times where the law or its derivatives jump: the integrator lands on them.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self.until.into_iter().collect();
+        match &self.law {
+            Law::SpinUp { ramp, .. } => b.push(*ramp),
+            Law::Table(rows) => b.extend(rows.iter().map(|r| r[0])),
+            _ => {}
+        }
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check_derivatives(law: &TimeLaw, ts: &[f64]) {
+        let h = 1e-5;
+        for &t in ts {
+            let (_, d1, d2) = law.eval(t, &[]);
+            let fd1 = (law.eval(t + h, &[]).0 - law.eval(t - h, &[]).0) / (2.0 * h);
+            let fd2 = (law.eval(t + h, &[]).1 - law.eval(t - h, &[]).1) / (2.0 * h);
+            assert!(
+                (d1 - fd1).abs() < 1e-6 * (1.0 + d1.abs()),
+                "{law:?} d1 at {t}"
+            );
+            assert!(
+                (d2 - fd2).abs() < 1e-5 * (1.0 + d2.abs()),
+                "{law:?} d2 at {t}"
+            );
+        }
+    }
+
+    #[test]
+    fn spin_up_is_smooth_and_reaches_omega() {
+        let law = TimeLaw {
+            law: Law::SpinUp {
+                omega: 4.0,
+                ramp: 15.0,
+            },
+            until: None,
+        };
+        check_derivatives(&law, &[0.3, 7.0, 14.0, 16.0]);
+        let (th, w, a) = law.eval(15.0, &[]);
+        assert!((th - 4.0 * 7.5).abs() < 1e-12 && (w - 4.0).abs() < 1e-12 && a.abs() < 1e-12);
+        assert_eq!(law.eval(0.0, &[]), (0.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn exponential_torque_cuts_off() {
+        let law = TimeLaw {
+            law: Law::Exponential {
+                value: 0.01,
+                tau: 0.167,
+            },
+            until: Some(0.7),
+        };
+        check_derivatives(&law, &[0.1, 0.5]);
+        assert!((law.eval(0.7, &[]).0 - 0.01 * (1.0 - (-0.7f64 / 0.167).exp())).abs() < 1e-15);
+        assert_eq!(law.eval(0.70001, &[]).0, 0.0);
+        assert_eq!(law.breakpoints(), vec![0.7]);
+    }
+
+    #[test]
+    fn table_interpolates() {
+        let law = TimeLaw {
+            law: Law::Table(vec![[0.0, 0.0], [1.0, 2.0], [3.0, 0.0]]),
+            until: None,
+        };
+        assert_eq!(law.eval(0.5, &[]), (1.0, 2.0, 0.0));
+        assert_eq!(law.eval(2.0, &[]), (1.0, -1.0, 0.0));
+        assert_eq!(law.eval(5.0, &[]).0, 0.0);
+    }
+}
