@@ -188,8 +188,14 @@ fn gravity_is_the_gradient_of_the_potential() {
 #[test]
 fn tangents_match_finite_differences() {
     let mut rng = Lcg(3);
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
-        let b = beam(frame, 3);
+    for (frame, stiffening) in [
+        (FrameKind::Tangent, false),
+        (FrameKind::Pinned, false),
+        (FrameKind::Tangent, true),
+        (FrameKind::Pinned, true),
+    ] {
+        let mut b = beam(frame, 3);
+        b.set_geometric_stiffening(stiffening);
         let n = b.ndof();
         let g = Vector2::new(0.5, -9.81);
         let (z, zd, zdd) = random_state(&b, &mut rng);
@@ -225,8 +231,14 @@ fn tangents_match_finite_differences() {
         }
         let ek = (&kt - &kfd).amax() / kfd.amax();
         let ec = (&ct - &cfd).amax() / cfd.amax();
-        assert!(ek < 1e-7, "{frame:?} K_t relative difference {ek:e}");
-        assert!(ec < 1e-7, "{frame:?} C_t relative difference {ec:e}");
+        assert!(
+            ek < 1e-7,
+            "{frame:?} stiffening {stiffening}: K_t relative difference {ek:e}"
+        );
+        assert!(
+            ec < 1e-7,
+            "{frame:?} stiffening {stiffening}: C_t relative difference {ec:e}"
+        );
     }
 }
 
@@ -267,4 +279,52 @@ fn steady_spin_loads_axially() {
             );
         }
     }
+}
+
+/// With geometric stiffening, the internal force is the gradient of the strain energy, and an
+/// axial pre-stretch stiffens bending: the transverse stiffness grows with the axial force.
+#[test]
+fn geometric_stiffening_is_conservative_and_stiffens_under_tension() {
+    let mut rng = Lcg(19);
+    let mut b = beam(FrameKind::Tangent, 4);
+    b.set_geometric_stiffening(true);
+    let n = b.ndof();
+    let (mut z, _, _) = random_state(&b, &mut rng);
+    let zero = DVector::zeros(n);
+    let r = residual(&b, &z, &zero, &zero, Vector2::zeros());
+    for k in FLEX..n {
+        let eps = 1e-7;
+        let (mut zp, mut zm) = (z.clone(), z.clone());
+        zp[k] += eps;
+        zm[k] -= eps;
+        let de = (b.strain_energy(&zp) - b.strain_energy(&zm)) / (2.0 * eps);
+        assert!(
+            (r[k] - de).abs() < 1e-5 * (1.0 + de.abs()),
+            "coordinate {k}: {} vs {de}",
+            r[k]
+        );
+    }
+    // tip transverse stiffness with and without a uniform axial stretch
+    let tip_v = FLEX + b.flex_index(3 * b.elements + 1).unwrap();
+    let stiffness = |z: &DVector<f64>| {
+        let mut kt = DMatrix::zeros(n, n);
+        let mut ct = DMatrix::zeros(n, n);
+        b.tangents(
+            z,
+            &zero,
+            &zero,
+            Vector2::zeros(),
+            kt.view_mut((0, 0), (n, n)),
+            ct.view_mut((0, 0), (n, n)),
+        );
+        kt[(tip_v, tip_v)]
+    };
+    z.fill(0.0);
+    let k0 = stiffness(&z);
+    for (k, &full) in b.kept.iter().enumerate() {
+        if full % 3 == 0 {
+            z[FLEX + k] = 1e-4 * (full / 3) as f64 * b.length / b.elements as f64;
+        }
+    }
+    assert!(stiffness(&z) > k0 * 1.01, "tension must stiffen bending");
 }

@@ -10,7 +10,7 @@
 //! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
 //! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
 
-use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4, GAUSS_5};
+use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
 use crate::scene::{BeamSpec, FrameKind};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix2, Vector2};
@@ -414,18 +414,19 @@ impl PlanarBeam {
         self.geometric_stiffening = on;
     }
 
-    /// Visits each element's Gauss points with the strain terms of the nonlinear axial strain:
-    /// (element root index, weight × length, u', v', d(u')/dq_e, d(v')/dq_e).
-    fn for_strain_points(
+    /// Visits each element with its axial strain ε = u' + ½⟨v'²⟩, the element mean of v'²
+    /// making ε (and the axial force) constant per element, which avoids membrane locking:
+    /// (kept index of each element coordinate, ℓ, ε, ∂ε/∂q_e, ⟨v'_q v'_qᵀ⟩).
+    #[allow(clippy::type_complexity)]
+    fn for_element_strains(
         &self,
         z: &DVector<f64>,
         mut visit: impl FnMut(
             &[Option<usize>; ELEMENT_DOFS],
             f64,
             f64,
-            f64,
             &[f64; ELEMENT_DOFS],
-            &[f64; ELEMENT_DOFS],
+            &[[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
         ),
     ) {
         let l = self.length / self.elements as f64;
@@ -435,42 +436,51 @@ impl PlanarBeam {
                 std::array::from_fn(|p| self.flex_index(3 * j + p));
             let qe: [f64; ELEMENT_DOFS] =
                 std::array::from_fn(|p| idx[p].map_or(0.0, |k| z[FLEX + k]));
-            let du: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
-            for &(xi, w) in &GAUSS_5 {
+            let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
+            let mut de = da;
+            let mut hv = [[0.0; ELEMENT_DOFS]; ELEMENT_DOFS];
+            for &(xi, w) in &GAUSS_4 {
                 let ds = planar_element::slope(xi, l);
                 let dv: f64 = (0..ELEMENT_DOFS).map(|p| ds[p] * qe[p]).sum();
-                visit(&idx, w * l, du, dv, &da, &ds);
+                eps += 0.5 * w * dv * dv;
+                for p in 0..ELEMENT_DOFS {
+                    de[p] += w * dv * ds[p];
+                    for r in 0..ELEMENT_DOFS {
+                        hv[p][r] += w * ds[p] * ds[r];
+                    }
+                }
             }
+            visit(&idx, l, eps, &de, &hv);
         }
     }
 
     /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
-    /// ∫EA (ε ∂ε/∂q - u' ∂u'/∂q) dx, added into `out`.
+    /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out`.
     fn stiffening_force(&self, z: &DVector<f64>, out: &mut [f64]) {
         let ea = self.ea;
-        self.for_strain_points(z, |idx, wl, du, dv, da, ds| {
-            let eps = du + 0.5 * dv * dv;
+        self.for_element_strains(z, |idx, l, eps, de, _| {
+            let du =
+                (idx[3].map_or(0.0, |k| z[FLEX + k]) - idx[0].map_or(0.0, |k| z[FLEX + k])) / l;
+            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 if let Some(k) = idx[p] {
-                    out[k] += wl * ea * (eps * (da[p] + dv * ds[p]) - du * da[p]);
+                    out[k] += ea * l * (eps * de[p] - du * da[p]);
                 }
             }
         });
     }
 
-    /// Tangent of [`Self::stiffening_force`], added into `k` (nf × nf block at (FLEX, FLEX)).
+    /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
     fn stiffening_tangent(&self, z: &DVector<f64>, kt: &mut DMatrixViewMut<f64>) {
         let ea = self.ea;
-        self.for_strain_points(z, |idx, wl, du, dv, da, ds| {
-            let eps = du + 0.5 * dv * dv;
+        self.for_element_strains(z, |idx, l, eps, de, hv| {
+            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 let Some(kp) = idx[p] else { continue };
                 for r in 0..ELEMENT_DOFS {
                     let Some(kr) = idx[r] else { continue };
-                    let de_p = da[p] + dv * ds[p];
-                    let de_r = da[r] + dv * ds[r];
                     kt[(FLEX + kp, FLEX + kr)] +=
-                        wl * ea * (de_p * de_r + eps * ds[p] * ds[r] - da[p] * da[r]);
+                        ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
                 }
             }
         });
@@ -480,9 +490,10 @@ impl PlanarBeam {
     fn stiffening_energy(&self, z: &DVector<f64>) -> f64 {
         let mut e = 0.0;
         let ea = self.ea;
-        self.for_strain_points(z, |_, wl, du, dv, _, _| {
-            let eps = du + 0.5 * dv * dv;
-            e += 0.5 * wl * ea * (eps * eps - du * du);
+        self.for_element_strains(z, |idx, l, eps, _, _| {
+            let du =
+                (idx[3].map_or(0.0, |k| z[FLEX + k]) - idx[0].map_or(0.0, |k| z[FLEX + k])) / l;
+            e += 0.5 * ea * l * (eps * eps - du * du);
         });
         e
     }

@@ -13,16 +13,6 @@ pub const GAUSS_4: [(f64, f64); 4] = [
     (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
 ];
 
-/// 5-point Gauss–Legendre rule on [0, 1], exact up to degree 9: the nonlinear strain energy
-/// (v'^4, degree 8) of geometric stiffening.
-pub const GAUSS_5: [(f64, f64); 5] = [
-    (0.046_910_077_030_668_0, 0.118_463_442_528_094_5),
-    (0.230_765_344_947_158_5, 0.239_314_335_249_683_2),
-    (0.5, 0.284_444_444_444_444_4),
-    (0.769_234_655_052_841_5, 0.239_314_335_249_683_2),
-    (0.953_089_922_969_332, 0.118_463_442_528_094_5),
-];
-
 /// Rows S_el1 (axial) and S_el2 (transverse) of the shape matrix, eq. (6), at ξ ∈ [0, 1].
 pub fn shape(xi: f64, l: f64) -> ([f64; ELEMENT_DOFS], [f64; ELEMENT_DOFS]) {
     let (x2, x3) = (xi * xi, xi * xi * xi);

@@ -56,6 +56,9 @@ impl Coefficients {
 }
 
 const MAX_NEWTON: usize = 8;
+/// Absolute part of the error weights, as a fraction of the system's length (or of 1 rad):
+/// a coordinate's local error must stay below tol × (|q_i| + ERROR_SCALE × scale_i).
+const ERROR_SCALE: f64 = 1.0;
 /// Newton stops when its correction is this fraction of the tolerance.
 const NEWTON_KAPPA: f64 = 0.01;
 
@@ -104,7 +107,7 @@ impl Stepper {
                 };
             }
         }
-        scale *= 1e-3;
+        scale *= ERROR_SCALE;
         Stepper {
             settings,
             scale,
