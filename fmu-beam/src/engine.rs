@@ -582,6 +582,11 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
         K::SolverNewtonIterations => m.stats.newton_iterations as f64,
         K::SolverJacobians => m.stats.jacobians as f64,
         K::SolverRejectedSteps => m.stats.rejected as f64,
+        K::ConstraintResidual => {
+            let mut g = nalgebra::DVector::zeros(sys.m());
+            sys.constraints(q, st.t, &mut g);
+            g.amax()
+        }
     }
 }
 

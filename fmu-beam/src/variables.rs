@@ -130,6 +130,8 @@ pub enum OutputKind {
     SolverNewtonIterations,
     SolverJacobians,
     SolverRejectedSteps,
+    /// Largest |g_k(q, t)| over the joint equations (m or rad): the constraint drift.
+    ConstraintResidual,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -613,6 +615,13 @@ impl VariableTable {
         ] {
             t.output(name.into(), VarType::Real, Some("J"), desc, kind);
         }
+        t.output(
+            "solver.constraint_residual".into(),
+            VarType::Real,
+            None,
+            "Largest residual of the joint equations |g(q, t)| (m or rad): the constraint drift",
+            K::ConstraintResidual,
+        );
         for (name, kind, desc) in [
             (
                 "solver.steps",

@@ -69,6 +69,8 @@ pub struct Stepper {
     pub settings: Settings,
     /// Error weight scale of each coordinate (length for translations, 1 for angles).
     scale: DVector<f64>,
+    /// Coordinates of massless bodies.
+    algebraic: Vec<usize>,
     lu: Option<LU<f64, Dyn, Dyn>>,
     lu_h: f64,
     // workspace
@@ -100,7 +102,11 @@ impl Stepper {
         let mut scale = DVector::zeros(n);
         for (i, b) in sys.bodies.iter().enumerate() {
             for k in 0..b.ndof() {
-                scale[sys.offsets[i] + k] = if b.is_angle(k) {
+                // a body without mass has algebraic coordinates, fixed by the joints: its
+                // "acceleration" carries no error information and stays out of the norm
+                scale[sys.offsets[i] + k] = if b.is_massless() {
+                    f64::INFINITY
+                } else if b.is_angle(k) {
                     1.0
                 } else {
                     sys.length_scale()
@@ -108,9 +114,11 @@ impl Stepper {
             }
         }
         scale *= ERROR_SCALE;
+        let algebraic = (0..n).filter(|&k| scale[k].is_infinite()).collect();
         Stepper {
             settings,
             scale,
+            algebraic,
             lu: None,
             lu_h: 0.0,
             mm: DMatrix::zeros(n, n),
@@ -164,10 +172,11 @@ impl Stepper {
             let target = breakpoints
                 .iter()
                 .copied()
-                .find(|&b| b > st.t * (1.0 + 1e-14) + 1e-14 && b < t_end)
+                .find(|&b| b > st.t * (1.0 + 1e-14) + 1e-14 && b <= t_end)
                 .unwrap_or(t_end);
             let remaining = target - st.t;
-            if remaining <= 4.0 * f64::EPSILON * target.abs().max(1.0) {
+            // a leftover of rounding (the sum of substeps falls short by an ulp) is no step
+            if remaining <= 1e-12 * target.abs().max(1.0) {
                 st.t = target;
                 continue;
             }
@@ -181,7 +190,10 @@ impl Stepper {
             } else if h > 0.5 * remaining {
                 h = 0.5 * remaining;
             }
-            let last = h >= remaining;
+            let last = h >= remaining * (1.0 - 1e-9);
+            if last {
+                h = remaining;
+            }
             let t_new = if last { target } else { st.t + h };
             match self.attempt(sys, st, stats, h, t_new) {
                 Ok((new, err)) => {
@@ -189,12 +201,17 @@ impl Stepper {
                         stats.rejected += 1;
                         h_try = h * (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0);
                     } else {
-                        let p0 = sys.power(&st.q, &st.v, &st.lambda, st.t);
+                        // the power at the step's start, as the limit from inside the step (a drive law
+                        // that stops at t_n acts no more in (t_n, t_n+1])
+                        let p0 = sys.power(&st.q, &st.v, &st.lambda, st.t + 1e-9 * h);
                         let p1 = sys.power(&new.q, &new.v, &new.lambda, t_new);
                         *st = new;
                         st.work += 0.5 * h * (p0 + p1);
                         st.t = t_new;
                         stats.steps += 1;
+                        if last && breakpoints.contains(&target) {
+                            restart(sys, st)?;
+                        }
                         if set.adaptive {
                             let grow = if err > 0.0 {
                                 0.9 * err.powf(-1.0 / 3.0)
@@ -360,8 +377,15 @@ impl Stepper {
             let converged = norm <= NEWTON_KAPPA
                 || (it > 0 && rate < 1.0 && norm * rate / (1.0 - rate) <= NEWTON_KAPPA);
             if converged {
-                let acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m + &qdd * (1.0 - c.alpha_f))
+                let mut acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m
+                    + &qdd * (1.0 - c.alpha_f))
                     / (1.0 - c.alpha_m);
+                // coordinates of massless bodies are algebraic: their accelerations enter no
+                // equation, and the scheme's recurrence would let them grow without bound
+                for &k in &self.algebraic {
+                    acc[k] = 0.0;
+                    qdd[k] = 0.0;
+                }
                 let err = (c.beta - 1.0 / 6.0).abs() * h * h;
                 let err = self.norm(&((&acc - &st.acc) * err), &q);
                 if rate > 0.5 && it > 0 {
@@ -393,4 +417,16 @@ impl Stepper {
             fresh,
         })
     }
+}
+
+/// Restarts the scheme at a jump of a drive law: the accelerations and multipliers become those
+/// of the equations just after the jump, so that the algorithmic acceleration carries no memory
+/// of the forces before it (without this the error order drops to one at the jump).
+fn restart(sys: &System, st: &mut GaState) -> Result<(), EngineError> {
+    let after = st.t * (1.0 + 1e-13) + 1e-13;
+    let (qdd, lambda) = super::initial::consistent_accelerations(sys, &st.q, &st.v, after)?;
+    st.acc = qdd.clone();
+    st.qdd = qdd;
+    st.lambda = lambda;
+    Ok(())
 }

@@ -42,6 +42,11 @@ impl Body {
         }
     }
 
+    /// A rigid body without mass and inertia (its coordinates are fixed by joints).
+    pub fn is_massless(&self) -> bool {
+        matches!(self, Body::Rigid(r) if r.mass == 0.0 && r.inertia == 0.0)
+    }
+
     /// True for coordinates that are angles (θ, nodal slopes); false for lengths.
     pub fn is_angle(&self, k: usize) -> bool {
         match self {

@@ -1,0 +1,70 @@
+//! Case C2 (planar paper §5.2, CASES.md): the flexible pendulum released from horizontal.
+
+mod common;
+use common::{run, scene};
+
+/// Rigid compound pendulum of length L released from horizontal:
+/// T = 4 sqrt(2L / (3g)) K(1/√2) = 1.22275 s for L = 0.4 (CASES.md).
+#[test]
+fn c2_stiff_beam_has_the_rigid_pendulum_period() {
+    let r = run(
+        scene("flexible_pendulum.toml"),
+        &[("beam.E", 1e14), ("solver.tolerance", 1e-9)],
+        &["hinge.angle", "hinge.speed"],
+        1e-3,
+        1.3,
+    );
+    // the angle returns to its maximum (0, horizontal) after one period: the speed crosses
+    // zero from positive to negative after the first half swing
+    let (t, w) = (r.column(0), r.column(2));
+    let k = (700..t.len() - 1)
+        .find(|&k| w[k] > 0.0 && w[k + 1] <= 0.0)
+        .expect("return swing");
+    let period = t[k] + (t[k + 1] - t[k]) * w[k] / (w[k] - w[k + 1]);
+    println!("period {period:.6} s (rigid pendulum 1.22275 s)");
+    assert!((period - 1.22275).abs() < 1e-4);
+}
+
+#[test]
+fn c2_single_frame_and_substructured_agree_and_conserve_energy() {
+    let outs = [
+        "hinge.angle",
+        "beam.tip.deflection",
+        "energy.total",
+        "energy.kinetic",
+    ];
+    let a = run(scene("flexible_pendulum.toml"), &[], &outs, 1e-3, 1.0);
+    let b = run(
+        scene("flexible_pendulum_substructured.toml"),
+        &[],
+        &outs,
+        1e-3,
+        1.0,
+    );
+    let mut worst: f64 = 0.0;
+    let mut worst_tip: f64 = 0.0;
+    let mut max_tip: f64 = 0.0;
+    for (ra, rb) in a.rows.iter().zip(&b.rows) {
+        worst = worst.max((ra[1] - rb[1]).abs());
+        worst_tip = worst_tip.max((ra[2] - rb[2]).abs());
+        max_tip = max_tip.max(ra[2].abs());
+    }
+    let swing = a.column(1).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    println!(
+        "swing angles differ by at most {worst:.3e} rad ({:.3} % of the swing {swing:.3} rad)",
+        100.0 * worst / swing
+    );
+    println!("tip deformation: max {max_tip:.3e} m; the models differ by up to {worst_tip:.3e} m");
+    assert!(worst < 0.01 * swing);
+    // energy: m g L/2 is released by the fall; no damping but the integrator's (rho_inf = 0.9)
+    let scale = 5540.0 * 0.0018 * 0.4 * 9.81 * 0.2;
+    for r in [&a, &b] {
+        let drift = r.column(3).iter().fold(0.0f64, |m, e| m.max(e.abs())) / scale;
+        println!("energy drift {drift:.2e} of m g L/2");
+        assert!(drift < 1e-5);
+        assert!(
+            r.column(4).iter().cloned().fold(0.0, f64::max) > 0.9 * scale,
+            "the pendulum falls"
+        );
+    }
+}
