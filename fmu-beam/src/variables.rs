@@ -167,78 +167,32 @@ pub struct UnitDef {
     pub rad: i32,
 }
 
+const fn unit(name: &'static str, kg: i32, m: i32, s: i32, rad: i32) -> UnitDef {
+    UnitDef {
+        name,
+        kg,
+        m,
+        s,
+        rad,
+    }
+}
+
 /// Every unit a variable may use.
 pub const UNITS: &[UnitDef] = &[
-    UnitDef {
-        name: "m",
-        kg: 0,
-        m: 1,
-        s: 0,
-        rad: 0,
-    },
-    UnitDef {
-        name: "rad",
-        kg: 0,
-        m: 0,
-        s: 0,
-        rad: 1,
-    },
-    UnitDef {
-        name: "s",
-        kg: 0,
-        m: 0,
-        s: 1,
-        rad: 0,
-    },
-    UnitDef {
-        name: "m/s2",
-        kg: 0,
-        m: 1,
-        s: -2,
-        rad: 0,
-    },
-    UnitDef {
-        name: "kg/m3",
-        kg: 1,
-        m: -3,
-        s: 0,
-        rad: 0,
-    },
-    UnitDef {
-        name: "Pa",
-        kg: 1,
-        m: -1,
-        s: -2,
-        rad: 0,
-    },
-    UnitDef {
-        name: "m2",
-        kg: 0,
-        m: 2,
-        s: 0,
-        rad: 0,
-    },
-    UnitDef {
-        name: "m4",
-        kg: 0,
-        m: 4,
-        s: 0,
-        rad: 0,
-    },
-    UnitDef {
-        name: "J",
-        kg: 1,
-        m: 2,
-        s: -2,
-        rad: 0,
-    },
-    UnitDef {
-        name: "1/s",
-        kg: 0,
-        m: 0,
-        s: -1,
-        rad: 0,
-    },
+    unit("m", 0, 1, 0, 0),
+    unit("rad", 0, 0, 0, 1),
+    unit("s", 0, 0, 1, 0),
+    unit("m/s", 0, 1, -1, 0),
+    unit("rad/s", 0, 0, -1, 1),
+    unit("m/s2", 0, 1, -2, 0),
+    unit("kg/m3", 1, -3, 0, 0),
+    unit("Pa", 1, -1, -2, 0),
+    unit("m2", 0, 2, 0, 0),
+    unit("m4", 0, 4, 0, 0),
+    unit("N", 1, 1, -2, 0),
+    unit("N.m", 1, 2, -2, 0),
+    unit("J", 1, 2, -2, 0),
+    unit("1/s", 0, 0, -1, 0),
 ];
 
 /// All variables of a scene, in value-reference order (vr = index; unique over all types).

@@ -1,0 +1,64 @@
+# fmu-beam: build the engine and the packager, package every scene, test, demo, bench.
+# `make demo` and `make test` are the two commands of the README; `make check` is what CI runs.
+
+SHELL := bash
+.SHELLFLAGS := -euo pipefail -c
+.DEFAULT_GOAL := test
+
+PYTHON3 ?= python3
+VENV    := .venv
+PY      := $(VENV)/bin/python
+STAMP   := $(VENV)/.requirements.stamp
+
+HARNESS := target/release/fmu-harness
+ENGINE  := target/release/libfmu_beam.so
+SCENES  := $(wildcard scenes/*.toml)
+
+.PHONY: .venv release fmus demo test check bench clean distclean
+
+# The Python environment: created once, refreshed when requirements.txt changes.
+.venv: $(STAMP)
+$(STAMP): requirements.txt
+	$(PYTHON3) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet -r requirements.txt
+	touch $@
+
+release:
+	cargo build --release --workspace
+
+# Every scene as build/fmus/<stem>.fmu. All scenes are tried; a scene that fails leaves no
+# (stale) FMU behind and fails the target. FMUs of scenes that no longer exist are removed.
+fmus: release
+	mkdir -p build/fmus
+	for f in build/fmus/*.fmu; do \
+	  [[ -e "$$f" ]] || continue; \
+	  [[ -e "scenes/$$(basename "$$f" .fmu).toml" ]] || rm -f "$$f"; \
+	done
+	failed=(); \
+	for s in $(SCENES); do \
+	  out="build/fmus/$$(basename "$$s" .toml).fmu"; \
+	  $(HARNESS) package "$$s" -o "$$out" --binary $(ENGINE) || { rm -f "$$out"; failed+=("$$s"); }; \
+	done; \
+	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
+
+demo: .venv fmus
+	$(PY) tests/demo.py
+
+test: .venv fmus
+	cargo test --workspace --release --no-fail-fast
+	$(PY) -m pytest tests -q
+
+check:
+	cargo fmt --all --check
+	cargo clippy --workspace --all-targets -- -D warnings
+	$(MAKE) test
+
+bench: .venv fmus
+	$(PY) tests/bench_c1.py
+
+clean:
+	rm -rf build .pytest_cache tests/__pycache__
+
+distclean: clean
+	rm -rf $(VENV)
+	cargo clean

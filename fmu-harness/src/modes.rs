@@ -1,0 +1,68 @@
+//! `fmu-harness modes`: the scene's linearized natural frequencies, rigid-body modes left out.
+
+use crate::error::HarnessError;
+use fmu_beam::Scene;
+use std::path::Path;
+
+/// Frequencies below this (Hz) are rigid-body modes.
+pub const RIGID_BODY_LIMIT_HZ: f64 = 1e-6;
+
+/// The elastic natural frequencies (Hz, ascending) of the scene file.
+pub fn elastic_frequencies(scene_path: &Path) -> Result<Vec<f64>, HarnessError> {
+    let scene = Scene::load(scene_path)?;
+    let f =
+        fmu_beam::modes::natural_frequencies(&scene).map_err(|source| HarnessError::Engine {
+            origin: scene_path.display().to_string(),
+            source,
+        })?;
+    Ok(f.into_iter()
+        .filter(|&f| f >= RIGID_BODY_LIMIT_HZ)
+        .collect())
+}
+
+/// `mode <k>: <f> Hz` lines, k from 1, at most `count` of them.
+pub fn report(frequencies: &[f64], count: usize) -> String {
+    frequencies
+        .iter()
+        .take(count)
+        .enumerate()
+        .map(|(k, f)| format!("mode {}: {} Hz\n", k + 1, significant(*f, 9)))
+        .collect()
+}
+
+/// `x` in fixed notation with `digits` significant digits (`%.9g` without exponent form).
+pub fn significant(x: f64, digits: usize) -> String {
+    if !x.is_finite() || x == 0.0 || digits == 0 {
+        return format!("{x}");
+    }
+    // The exponent after rounding to `digits` digits (9.9999999996 → 1.00000000e1).
+    let sci = format!("{:.*e}", digits - 1, x);
+    let exp: i64 = sci
+        .rsplit_once('e')
+        .and_then(|(_, e)| e.parse().ok())
+        .unwrap_or(0);
+    let decimals = (digits as i64 - 1 - exp).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{report, significant};
+
+    #[test]
+    fn nine_significant_digits() {
+        assert_eq!(significant(2.0854751, 9), "2.08547510");
+        assert_eq!(significant(118.84259, 9), "118.842590");
+        assert_eq!(significant(9.9999999996, 9), "10.0000000");
+        assert_eq!(significant(0.0123456789012, 9), "0.0123456789");
+        assert_eq!(significant(1234567890123.0, 9), "1234567890123");
+    }
+
+    #[test]
+    fn report_numbers_modes_from_one() {
+        assert_eq!(
+            report(&[1.5, 2.5, 3.5], 2),
+            "mode 1: 1.50000000 Hz\nmode 2: 2.50000000 Hz\n"
+        );
+    }
+}

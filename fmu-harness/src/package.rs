@@ -1,0 +1,176 @@
+//! `fmu-harness package`: a scene file → an FMI 2.0 co-simulation FMU.
+//!
+//! Layout of the FMU: `modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so` (the
+//! engine cdylib under the scene's name), `resources/scene.toml` (the canonical scene text the
+//! engine reads in fmi2Instantiate) and `resources/guid.txt` (checked there against fmuGUID).
+
+use crate::archive::{self, Entry};
+use crate::error::HarnessError;
+use crate::guid::guid;
+use crate::model_description;
+use fmu_beam::variables::VariableTable;
+use fmu_beam::Scene;
+use std::path::{Path, PathBuf};
+
+/// File name of the engine cdylib that cargo builds.
+pub const ENGINE_LIBRARY: &str = "libfmu_beam.so";
+
+/// Platform folder of x86_64 Linux binaries in an FMI 2.0 FMU.
+pub const PLATFORM: &str = "linux64";
+
+/// What a packaging run produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Packaged {
+    pub output: PathBuf,
+    pub model_identifier: String,
+    pub guid: String,
+    pub variables: usize,
+    pub binary: PathBuf,
+}
+
+/// The files of an FMU, before zipping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FmuContents {
+    pub model_identifier: String,
+    pub guid: String,
+    pub model_description: String,
+    pub scene_text: String,
+    pub variables: usize,
+}
+
+/// modelDescription.xml, scene text and GUID of a scene packaged with the given engine binary.
+pub fn contents(scene: &Scene, binary: &[u8]) -> Result<FmuContents, HarnessError> {
+    let table = VariableTable::build(scene);
+    let scene_text = canonical_text(scene)?;
+    let unsigned = model_description::render(scene, &table, "")?;
+    let guid = guid(&[unsigned.as_bytes(), scene_text.as_bytes(), binary]);
+    let model_description = model_description::render(scene, &table, &guid)?;
+    Ok(FmuContents {
+        model_identifier: scene.name.clone(),
+        guid,
+        model_description,
+        scene_text,
+        variables: table.variables.len(),
+    })
+}
+
+/// The scene text the engine will read, checked to read back as the same scene.
+fn canonical_text(scene: &Scene) -> Result<String, HarnessError> {
+    let text = scene.to_toml_string();
+    let refuse = |message: String| HarnessError::CanonicalScene {
+        scene: scene.name.clone(),
+        message,
+    };
+    match Scene::from_toml_str(&text, "resources/scene.toml") {
+        Ok(back) if back == *scene && !text.is_empty() => Ok(text),
+        Ok(_) => Err(refuse("it reads back as a different scene".into())),
+        Err(e) => Err(refuse(e.to_string())),
+    }
+}
+
+/// Loads the scene, builds the FMU and writes it to `output` (atomically).
+pub fn package(
+    scene_path: &Path,
+    output: &Path,
+    binary: Option<&Path>,
+) -> Result<Packaged, HarnessError> {
+    let scene = Scene::load(scene_path)?;
+    let binary = match binary {
+        Some(b) => b.to_path_buf(),
+        None => default_binary()?,
+    };
+    let lib = std::fs::read(&binary)
+        .map_err(|e| HarnessError::io(&binary, "reading the engine library", e))?;
+    let c = contents(&scene, &lib)?;
+    let so_path = format!("binaries/{PLATFORM}/{}.so", c.model_identifier);
+    archive::write_fmu(
+        output,
+        &[
+            Entry {
+                path: "modelDescription.xml",
+                data: c.model_description.as_bytes(),
+                mode: 0o644,
+            },
+            Entry {
+                path: &so_path,
+                data: &lib,
+                mode: 0o755,
+            },
+            Entry {
+                path: "resources/scene.toml",
+                data: c.scene_text.as_bytes(),
+                mode: 0o644,
+            },
+            Entry {
+                path: "resources/guid.txt",
+                data: c.guid.as_bytes(),
+                mode: 0o644,
+            },
+        ],
+    )?;
+    Ok(Packaged {
+        output: output.to_path_buf(),
+        model_identifier: c.model_identifier,
+        guid: c.guid,
+        variables: c.variables,
+        binary,
+    })
+}
+
+/// The engine cdylib of the harness's target directory: `target/release/`, else beside this
+/// executable (`target/<profile>/`).
+pub fn default_binary() -> Result<PathBuf, HarnessError> {
+    let exe = std::env::current_exe()
+        .map_err(|e| HarnessError::io("fmu-harness", "locating the executable", e))?;
+    let candidates = binary_candidates(&exe);
+    candidates
+        .iter()
+        .find(|p| p.is_file())
+        .cloned()
+        .ok_or(HarnessError::BinaryNotFound {
+            searched: candidates,
+        })
+}
+
+/// Where to look for the engine library, in order, given the harness executable's path.
+pub fn binary_candidates(exe: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let Some(mut dir) = exe.parent() else {
+        return out;
+    };
+    // test executables live in target/<profile>/deps
+    if dir.file_name().is_some_and(|n| n == "deps") {
+        if let Some(p) = dir.parent() {
+            dir = p;
+        }
+    }
+    if let Some(target) = dir.parent() {
+        out.push(target.join("release").join(ENGINE_LIBRARY));
+    }
+    let beside = dir.join(ENGINE_LIBRARY);
+    if !out.contains(&beside) {
+        out.push(beside);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::binary_candidates;
+    use std::path::{Path, PathBuf};
+
+    #[test]
+    fn engine_library_is_looked_for_in_release_then_beside_the_executable() {
+        assert_eq!(
+            binary_candidates(Path::new("/r/target/debug/fmu-harness")),
+            vec![
+                PathBuf::from("/r/target/release/libfmu_beam.so"),
+                PathBuf::from("/r/target/debug/libfmu_beam.so")
+            ]
+        );
+        assert_eq!(
+            binary_candidates(Path::new("/r/target/release/deps/x-123")),
+            vec![PathBuf::from("/r/target/release/libfmu_beam.so")]
+        );
+    }
+}
