@@ -1,0 +1,96 @@
+//! Case C4 (planar paper §5.4, CASES.md): the spin-up manoeuvre of an 8 m beam clamped to a
+//! driven hub, and centrifugal stiffening. The tip deflection is measured in the hub frame.
+
+mod common;
+use common::{run, scene};
+use fmu_beam::{Engine, EngineError, Scene};
+
+fn with_substructures(file: &str, k: usize) -> Scene {
+    let mut s = scene(file);
+    s.beams[0].substructures = Some(k);
+    s
+}
+
+/// Peak |tip deflection| over the run, and the whole series (t, deflection).
+fn peak(s: Scene, params: &[(&str, f64)]) -> (f64, Vec<Vec<f64>>) {
+    let r = run(s, params, &["beam.tip.deflection"], 0.05, 20.0);
+    let p = r.column(1).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (p, r.rows)
+}
+
+/// Refining substructures and tolerance, the peak tip deflection converges; the test prints
+/// the sequences.
+#[test]
+fn c4_tip_deflection_converges_with_substructures_and_steps() {
+    for (file, ks) in [
+        ("spin_up_omega2.toml", [3, 5, 10]),
+        ("spin_up_omega4.toml", [3, 5, 10]),
+        ("spin_up_omega10.toml", [5, 10, 20]),
+    ] {
+        let peaks: Vec<f64> = ks
+            .iter()
+            .map(|&k| peak(with_substructures(file, k), &[]).0)
+            .collect();
+        let d1 = (peaks[1] - peaks[0]).abs();
+        let d2 = (peaks[2] - peaks[1]).abs();
+        println!("{file}: peak |tip deflection| for {ks:?} substructures: {peaks:.5?} m (changes {d1:.2e}, {d2:.2e})");
+        assert!(d2 < d1, "{file}: no convergence with substructures");
+        assert!(
+            d2 < 0.02 * peaks[2],
+            "{file}: last refinement still moves the peak by {d2:e}"
+        );
+        let (tight, _) = peak(scene(file), &[("solver.tolerance", 1e-8)]);
+        let (base, _) = peak(scene(file), &[]);
+        println!("{file}: peak at tolerance 1e-6 {base:.6} m, at 1e-8 {tight:.6} m");
+        assert!((tight - base).abs() < 1e-3 * tight);
+    }
+}
+
+/// After the spin-up (T = 15 s) the Omega = 10 deflection is small against its peak and does
+/// not grow; the geometrically stiffened single frame follows the substructured beam (20
+/// substructures: its peak is within 0.5 % of 40 substructures) within 5 % of the peak.
+#[test]
+fn c4_omega10_bounded_after_spin_up_and_stiffened_single_frame_agrees() {
+    let (p_sub, sub) = peak(with_substructures("spin_up_omega10.toml", 20), &[]);
+    let (p_stiff, stiff) = peak(scene("spin_up_omega10_stiffened.toml"), &[]);
+    let amp = |rows: &[Vec<f64>], a: f64, b: f64| {
+        rows.iter()
+            .filter(|r| r[0] >= a && r[0] <= b)
+            .fold(0.0f64, |m, r| m.max(r[1].abs()))
+    };
+    let (early, late) = (amp(&sub, 15.0, 17.5), amp(&sub, 17.5, 20.0));
+    println!("substructured: peak {p_sub:.4} m; after T: max {early:.3e} m in [15, 17.5] s, {late:.3e} m in [17.5, 20] s");
+    assert!(early < 0.05 * p_sub && late <= 1.2 * early);
+    let worst = sub
+        .iter()
+        .zip(&stiff)
+        .fold(0.0f64, |m, (a, b)| m.max((a[1] - b[1]).abs()));
+    println!("stiffened single frame: peak {p_stiff:.4} m; largest difference to the substructured beam {worst:.3e} m ({:.1} % of the peak)", 100.0 * worst / p_sub);
+    assert!(worst < 0.05 * p_sub);
+}
+
+/// A single linear frame spun above its first bending frequency (2.909 rad/s) softens
+/// without bound: the FMU warns, then refuses the step that runs away (fmi2Discard) and
+/// keeps the last good state.
+#[test]
+fn c4_single_frame_runaway_is_refused_with_a_message() {
+    let mut e = Engine::new(scene("spin_up_omega10_single_frame.toml"));
+    e.exit_initialization().unwrap();
+    let (mut t, h) = (0.0, 0.1);
+    let err = loop {
+        match e.do_step(t, h) {
+            Ok(()) => t += h,
+            Err(err) => break err,
+        }
+        assert!(t < 20.0, "the single-frame beam never ran away");
+    };
+    let warnings = e.take_messages();
+    println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
+    assert!(matches!(err, EngineError::Runaway { .. }) && err.is_discard());
+    assert!(err.to_string().contains("substructures"));
+    assert!(warnings
+        .iter()
+        .any(|w| w.contains("beam 'beam'") && w.contains("substructures")));
+    assert_eq!(e.time(), t, "the last good state stays");
+    assert!(t > 2.0 && t < 10.0);
+}
