@@ -18,6 +18,9 @@ struct Model {
     state: GaState,
     stats: Stats,
     stepper: Stepper,
+    /// Input values and derivatives (3 per input) of the last step: when the master changes
+    /// them, the scheme restarts from accelerations consistent with the new inputs.
+    applied_inputs: Vec<f64>,
     /// System joint index of each scene joint, system body index of each scene body.
     joint_index: Vec<usize>,
     body_index: Vec<usize>,
@@ -30,7 +33,7 @@ pub struct Snapshot {
     start_time: f64,
     values: Vec<f64>,
     input_ders: Vec<[f64; 2]>,
-    state: Option<(GaState, Stats)>,
+    state: Option<(GaState, Stats, Vec<f64>)>,
 }
 
 #[derive(Debug, Clone)]
@@ -162,9 +165,13 @@ impl Engine {
         std::mem::take(&mut self.messages)
     }
 
-    /// Copies the input values and derivatives into the system, held from time t0.
-    fn sync_inputs(&mut self, t0: f64) {
-        let Some(m) = &mut self.model else { return };
+    /// Copies the input values and derivatives into the system, held from time t0. An input
+    /// that changed is a jump of the applied forces or motions at t0: the scheme restarts there
+    /// (consistent accelerations and multipliers), as it does at a jump of a drive law.
+    fn sync_inputs(&mut self, t0: f64) -> Result<(), EngineError> {
+        let Some(m) = &mut self.model else {
+            return Ok(());
+        };
         for (i, var) in self.table.variables.iter().enumerate() {
             if let Binding::Input(slot) = var.binding {
                 let [der1, der2] = self.input_ders[i];
@@ -176,6 +183,18 @@ impl Engine {
                 };
             }
         }
+        let applied = flat_inputs(&m.system);
+        if applied != m.applied_inputs {
+            let st = &mut m.state;
+            let after = st.t * (1.0 + 1e-13) + 1e-13;
+            let (qdd, lambda) =
+                integrator::initial::consistent_accelerations(&m.system, &st.q, &st.v, after)?;
+            st.acc = qdd.clone();
+            st.qdd = qdd;
+            st.lambda = lambda;
+            m.applied_inputs = applied;
+        }
+        Ok(())
     }
 
     fn lookup(&self, vr: u32, ty: VarType) -> Result<usize, EngineError> {
@@ -303,6 +322,7 @@ impl Engine {
                 })
                 .collect();
             self.model = Some(Model {
+                applied_inputs: flat_inputs(&system),
                 stepper: Stepper::new(&system, settings),
                 system,
                 state,
@@ -357,7 +377,7 @@ impl Engine {
             });
         }
         self.built()?;
-        self.sync_inputs(now);
+        self.sync_inputs(now)?;
         let m = self.model.as_mut().expect("built above");
         let saved = (m.state.clone(), m.stats);
         let mut result = m
@@ -415,7 +435,10 @@ impl Engine {
             start_time: self.start_time,
             values: self.values.clone(),
             input_ders: self.input_ders.clone(),
-            state: self.model.as_ref().map(|m| (m.state.clone(), m.stats)),
+            state: self
+                .model
+                .as_ref()
+                .map(|m| (m.state.clone(), m.stats, m.applied_inputs.clone())),
         }
     }
 
@@ -425,15 +448,21 @@ impl Engine {
         self.start_time = s.start_time;
         self.model = None;
         self.initialized = false;
-        if let Some((state, stats)) = &s.state {
+        if let Some((state, stats, applied)) = &s.state {
             let m = self.built()?;
             if state.q.len() != m.state.q.len() || state.lambda.len() != m.state.lambda.len() {
                 return Err(EngineError::BadState {
                     message: "the state does not belong to this model".into(),
                 });
             }
+            if applied.len() != m.applied_inputs.len() {
+                return Err(EngineError::BadState {
+                    message: "the state has another number of inputs".into(),
+                });
+            }
             m.state = state.clone();
             m.stats = *stats;
+            m.applied_inputs = applied.clone();
         }
         self.initialized = s.initialized;
         Ok(())
@@ -460,10 +489,11 @@ impl Engine {
         put_vec(&mut w, &ders);
         match &s.state {
             None => w.push(0),
-            Some((st, stats)) => {
+            Some((st, stats, applied)) => {
                 w.push(1);
                 st.write(&mut w);
                 stats.write(&mut w);
+                put_vec(&mut w, applied);
             }
         }
         w
@@ -502,7 +532,7 @@ impl Engine {
         let input_ders = ders.chunks(2).map(|c| [c[0], c[1]]).collect();
         let state = match r.u8()? {
             0 => None,
-            1 => Some((GaState::read(&mut r)?, Stats::read(&mut r)?)),
+            1 => Some((GaState::read(&mut r)?, Stats::read(&mut r)?, r.vec()?)),
             _ => return Err(bad("corrupt flag")),
         };
         if r.pos != bytes.len() {
@@ -592,6 +622,14 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
 
 fn beam_section(sys: &System, g: usize) -> crate::beam::section::Section {
     sys.beams[g].section
+}
+
+/// Values and derivatives of the system's inputs, 3 per input.
+fn flat_inputs(sys: &System) -> Vec<f64> {
+    sys.inputs
+        .iter()
+        .flat_map(|u| [u.value, u.der1, u.der2])
+        .collect()
 }
 
 fn put_vec(w: &mut Vec<u8>, v: &[f64]) {
