@@ -25,14 +25,16 @@ pub fn initial_state(
     if m > 0 {
         sys.constraint_jacobian(&q, t0, &mut gm);
         check_rank(sys, &gm, t0)?;
+        let frames = sys.frame_coordinates();
         let mut iterations = 0;
+        let mut last_residual = f64::INFINITY;
         loop {
             sys.constraints(&q, t0, &mut g);
             let residual = g.amax();
             if residual <= tol {
                 break;
             }
-            if iterations == ASSEMBLY_ITERATIONS || !residual.is_finite() {
+            if iterations >= ASSEMBLY_ITERATIONS || !residual.is_finite() {
                 let rows: Vec<usize> = (0..m).filter(|&i| g[i].abs() > tol).collect();
                 return Err(EngineError::Assembly {
                     t: t0,
@@ -43,16 +45,31 @@ pub fn initial_state(
                 });
             }
             sys.constraint_jacobian(&q, t0, &mut gm);
-            // minimum-norm correction Δq = -Gᵀ (G Gᵀ)⁻¹ g
-            let ggt = &gm * gm.transpose();
-            let y = ggt.lu().solve(&g).ok_or_else(|| EngineError::Assembly {
-                t: t0,
-                residual,
-                joints: sys.joints_of_rows(&(0..m).collect::<Vec<_>>()).join(", "),
-                tolerance: tol,
-                iterations,
-            })?;
-            q -= gm.transpose() * y;
+            // Gauss–Newton on the frame coordinates only: assembling a mechanism places its
+            // bodies, it must not deform a beam to close a loop. Least squares (SVD), because a
+            // beam held at both ends over-determines its frame.
+            let gr = DMatrix::from_fn(m, frames.len(), |i, j| gm[(i, frames[j])]);
+            let dr = gr
+                .svd(true, true)
+                .solve(&g, 1e-12)
+                .map_err(|_| EngineError::Assembly {
+                    t: t0,
+                    residual,
+                    joints: sys.joints_of_rows(&(0..m).collect::<Vec<_>>()).join(", "),
+                    tolerance: tol,
+                    iterations,
+                })?;
+            for (j, &k) in frames.iter().enumerate() {
+                q[k] -= dr[j];
+            }
+            if (iterations > 5 && residual > 0.5 * last_residual)
+                || !dr.iter().all(|x| x.is_finite())
+            {
+                // not converging: no placement of the bodies satisfies the joints
+                iterations = ASSEMBLY_ITERATIONS;
+                continue;
+            }
+            last_residual = residual;
             iterations += 1;
         }
     }

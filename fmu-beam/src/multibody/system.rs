@@ -370,6 +370,11 @@ impl System {
         }
     }
 
+    /// Indices in q of the frame coordinates (x, y, θ) of every body, not its deformation.
+    pub fn frame_coordinates(&self) -> Vec<usize> {
+        self.offsets.iter().flat_map(|&o| o..o + 3).collect()
+    }
+
     /// Coordinates of body `i`.
     pub fn body_coords(&self, i: usize, q: &DVector<f64>) -> DVector<f64> {
         q.rows(self.offsets[i], self.bodies[i].ndof()).into_owned()
