@@ -55,6 +55,7 @@ check:
 
 bench: .venv fmus
 	$(PY) tests/bench_c1.py
+	$(HARNESS) work-precision --scenes scenes --output build/bench
 
 clean:
 	rm -rf build .pytest_cache tests/__pycache__

@@ -1,7 +1,7 @@
-//! The command line: `package` and `modes`.
+//! The command line: `package`, `modes` and `work-precision`.
 
 use crate::error::HarnessError;
-use crate::{modes, package};
+use crate::{modes, package, work_precision};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -39,6 +39,31 @@ pub enum Command {
         #[arg(long, default_value_t = 10)]
         count: usize,
     },
+    /// Work-precision study of the validation cases (error against a tight-tolerance reference
+    /// versus time, over the integrator tolerance); writes work_precision.csv and .md.
+    WorkPrecision {
+        /// Directory of the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Output directory.
+        #[arg(short, long, default_value = "build/bench")]
+        output: PathBuf,
+        /// Timed runs per point (median, min and max are reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Tolerances of the error control to sweep.
+        #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8])]
+        tolerances: Vec<f64>,
+        /// Fixed internal steps (s) to sweep.
+        #[arg(long, value_delimiter = ',', default_values_t = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4])]
+        steps: Vec<f64>,
+        /// Tolerance of the reference run.
+        #[arg(long, default_value_t = 1e-9)]
+        reference: f64,
+        /// Only these cases (C1, C2, C2-tip, C3, C3-rigid-crank, C4-omega10, ...).
+        #[arg(long, value_delimiter = ',')]
+        cases: Vec<String>,
+    },
 }
 
 /// Runs one command, writing its report to `out`.
@@ -61,6 +86,37 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 p.binary.display()
             )
             .map_err(stdout_err)?;
+        }
+        Command::WorkPrecision {
+            scenes,
+            output,
+            repeats,
+            tolerances,
+            steps,
+            reference,
+            cases,
+        } => {
+            let settings: Vec<_> = tolerances
+                .iter()
+                .map(|&t| work_precision::Setting::Tolerance(t))
+                .chain(steps.iter().map(|&h| work_precision::Setting::FixedStep(h)))
+                .collect();
+            let chosen: Vec<_> = work_precision::CASES
+                .iter()
+                .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
+                .cloned()
+                .collect();
+            let points = work_precision::study(
+                &scenes,
+                &chosen,
+                &settings,
+                repeats,
+                reference,
+                &mut |line| eprintln!("{line}"),
+            )?;
+            for path in work_precision::write(&output, &points)? {
+                writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
+            }
         }
         Command::Modes { scene, count } => {
             let f = modes::elastic_frequencies(&scene)?;

@@ -14,5 +14,6 @@ pub mod model_description;
 pub mod modes;
 pub mod package;
 pub mod template;
+pub mod work_precision;
 
 pub use error::HarnessError;
