@@ -61,6 +61,24 @@ const MAX_NEWTON: usize = 8;
 const ERROR_SCALE: f64 = 1.0;
 /// Newton stops when its correction is this fraction of the tolerance.
 const NEWTON_KAPPA: f64 = 0.01;
+/// Largest growth of the step size from one step to the next.
+const MAX_GROWTH: f64 = 5.0;
+/// A proposed growth of the step size up to this factor keeps the step size, and with it the
+/// factorized iteration matrix (hysteresis).
+const KEEP_STEP: f64 = 1.2;
+/// Step sizes within this relative difference share an iteration matrix (equal substeps of a
+/// fixed-step run differ by rounding).
+const SAME_STEP: f64 = 1e-9;
+
+/// The factor on the step size after an accepted step whose controller proposes `grow`.
+fn step_factor(grow: f64) -> f64 {
+    let grow = grow.clamp(0.2, MAX_GROWTH);
+    if (1.0..=KEEP_STEP).contains(&grow) {
+        1.0
+    } else {
+        grow
+    }
+}
 
 /// The integrator with its workspace. The factorized iteration matrix is reused across
 /// Newton iterations and internal steps of one communication step, while it converges well.
@@ -216,9 +234,9 @@ impl Stepper {
                             let grow = if err > 0.0 {
                                 0.9 * err.powf(-1.0 / 3.0)
                             } else {
-                                5.0
+                                MAX_GROWTH
                             };
-                            h_try = h * grow.clamp(0.2, 5.0);
+                            h_try = h * step_factor(grow);
                             // keep the proposal when the step was cut short to land
                             if !last {
                                 st.h = h_try;
@@ -330,7 +348,7 @@ impl Stepper {
         let d = c.beta * h * h;
         let beta_p = (1.0 - c.alpha_m) / (d * (1.0 - c.alpha_f));
         let gamma_p = c.gamma / (c.beta * h);
-        if self.lu.is_some() && self.lu_h != h {
+        if self.lu.is_some() && (h - self.lu_h).abs() > SAME_STEP * h {
             self.lu = None;
         }
         // predictor: q''_{n+1} = q''_n
