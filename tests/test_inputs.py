@@ -114,3 +114,59 @@ def test_fmu_state_with_changing_inputs_restores_bit_for_bit(arm):
     fmu.terminate()
     fmu.freeInstance()
     assert first == again
+
+
+def test_nan_input_is_refused_and_a_diverging_step_is_discarded_then_reset_runs_again(arm):
+    """NaN into an input: fmi2Error with a message, the instance keeps its state. A torque so
+    large that the step diverges: fmi2Discard with a message, the last good state readable;
+    after fmi2Reset the instance runs as a fresh one does."""
+    from fmpy.fmi1 import FMICallException
+
+    from fmu_util import Logger
+
+    md, unzip, vr = arm
+    log = Logger()
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="diverging")
+    fmu.instantiate(loggingOn=True, callbacks=log.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    torque, angle = vr["hub.drive.torque"], vr["hub.angle"]
+    fmu.setReal([torque], [10.0])
+    fmu.doStep(0.0, 0.1)
+    good = fmu.getReal([angle])[0]
+
+    with pytest.raises(FMICallException) as nan:
+        fmu.setReal([torque], [float("nan")])
+    assert nan.value.status == 3  # fmi2Error
+    assert any("hub.drive.torque" in m and "not a finite number" in m for m in log.errors()), log.text()
+    fmu.doStep(0.1, 0.1)  # still running, with the last good input
+    good = fmu.getReal([angle])[0]
+    t = 0.2
+
+    fmu.setReal([torque], [1e30])
+    with pytest.raises(FMICallException) as diverged:
+        fmu.doStep(t, 0.1)
+    assert diverged.value.status == 2  # fmi2Discard
+    discards = [m for st, _, m in log.messages if st == 2]
+    print("discard message:", discards[-1] if discards else log.text())
+    assert discards, log.text()
+    assert fmu.getReal([angle])[0] == good
+    assert fmu.getRealStatus(2) == pytest.approx(t)  # fmi2LastSuccessfulTime
+
+    fmu.reset()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.setReal([torque], [10.0])
+    fmu.doStep(0.0, 0.1)
+    again = fmu.getReal([angle])[0]
+    fmu.terminate()
+    fmu.freeInstance()
+    fresh = instance(arm, name="fresh")
+    fresh.setReal([torque], [10.0])
+    fresh.doStep(0.0, 0.1)
+    assert again == fresh.getReal([angle])[0]
+    fresh.terminate()
+    fresh.freeInstance()
