@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv release fmus demo test check bench clean distclean
+.PHONY: .venv tools release fmus demo test check bench clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -22,6 +22,11 @@ $(STAMP): requirements.txt
 	$(PYTHON3) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet -r requirements.txt
 	touch $@
+
+# System tools the tests use: valgrind (the leak test) and gcc (its C master), from Debian.
+tools:
+	@command -v gcc >/dev/null && command -v valgrind >/dev/null || { \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind gcc libc6-dev; }
 
 release:
 	cargo build --release --workspace
@@ -44,7 +49,7 @@ fmus: release
 demo: .venv fmus
 	$(PY) tests/demo.py
 
-test: .venv fmus
+test: .venv tools fmus
 	cargo test --workspace --release --no-fail-fast
 	$(PY) -m pytest tests -q
 
