@@ -18,3 +18,6 @@ pub mod state_machine;
 pub mod types;
 
 pub use logger::LOG_CATEGORIES;
+
+#[cfg(test)]
+mod abi_tests;

@@ -10,13 +10,12 @@
 //! refuses a wrong GUID, missing resources, a bad scene, with a message; file URI forms;
 //! every '%' of a message is doubled.
 
-// Calling the C ABI takes unsafe code; the crate itself allows it in `fmi2/` only.
-#![allow(unsafe_code)]
+// Calling the C ABI takes unsafe code: these tests live in `fmi2/`, where the crate allows it.
 
-use fmu_beam::fmi2::exports::*;
-use fmu_beam::fmi2::types::*;
-use fmu_beam::variables::VariableTable;
-use fmu_beam::Scene;
+use crate::fmi2::exports::*;
+use crate::fmi2::types::*;
+use crate::variables::VariableTable;
+use crate::Scene;
 use std::ffi::{CStr, CString};
 use std::os::raw::{c_char, c_int, c_void};
 use std::path::{Path, PathBuf};
@@ -180,7 +179,7 @@ fn vr(name: &str) -> fmi2ValueReference {
 
 /// Value references of every Real output.
 fn real_outputs() -> Vec<fmi2ValueReference> {
-    use fmu_beam::variables::{Causality, VarType};
+    use crate::variables::{Causality, VarType};
     let scene = Scene::from_toml_str(SCENE, "test").unwrap();
     VariableTable::build(&scene)
         .variables
@@ -1074,7 +1073,7 @@ fn debug_logging_categories() {
         fmi2OK,
         "all categories"
     );
-    let all_categories: Vec<&str> = fmu_beam::fmi2::LOG_CATEGORIES
+    let all_categories: Vec<&str> = crate::fmi2::LOG_CATEGORIES
         .iter()
         .map(|(n, _)| *n)
         .collect();
