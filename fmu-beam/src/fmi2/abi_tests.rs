@@ -1106,3 +1106,165 @@ fn no_logger_callback_does_not_crash() {
         fmi2FreeInstance(c);
     }
 }
+
+/// Random sequences of FMI calls with random arguments (illegal orders, unknown value
+/// references, null pointers where the standard lets an FMU check, NaN and negative steps,
+/// garbage state bytes, calls after terminate): every call returns a status, nothing
+/// crashes, and a fresh instance afterwards runs bit for bit as one that never saw them.
+#[test]
+fn random_call_sequences_never_crash() {
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRunner};
+
+    #[derive(Debug, Clone)]
+    enum Call {
+        Setup(f64),
+        Enter,
+        Exit,
+        DoStep(f64, bool),
+        GetReal(u32, bool),
+        SetReal(u32, f64),
+        GetInteger(u32),
+        SetBoolean(u32, bool),
+        StateRoundTrip,
+        Deserialize(Vec<u8>),
+        Reset,
+        Terminate,
+        Status(i32),
+        Logging(bool, u8),
+        Cancel,
+    }
+    let value = prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(-1.0),
+        Just(0.0),
+        Just(1e-3),
+        Just(1e300),
+        any::<f64>()
+    ];
+    let call = prop_oneof![
+        value.clone().prop_map(Call::Setup),
+        Just(Call::Enter),
+        Just(Call::Exit),
+        (
+            prop_oneof![Just(H), Just(-H), Just(0.0), Just(f64::NAN), Just(1e-2)],
+            any::<bool>()
+        )
+            .prop_map(|(h, t)| Call::DoStep(h, t)),
+        (0u32..60, any::<bool>()).prop_map(|(v, n)| Call::GetReal(v, n)),
+        (0u32..60, value).prop_map(|(v, x)| Call::SetReal(v, x)),
+        (0u32..60).prop_map(Call::GetInteger),
+        (0u32..60, any::<bool>()).prop_map(|(v, b)| Call::SetBoolean(v, b)),
+        Just(Call::StateRoundTrip),
+        prop::collection::vec(any::<u8>(), 0..64).prop_map(Call::Deserialize),
+        Just(Call::Reset),
+        Just(Call::Terminate),
+        (-1i32..5).prop_map(Call::Status),
+        (any::<bool>(), 0u8..8).prop_map(|(on, k)| Call::Logging(on, k)),
+        Just(Call::Cancel),
+    ];
+    let res = Resources::cantilever();
+    let reference = {
+        let mut f = Fmu::new(&res);
+        f.initialize();
+        f.run(20)
+    };
+    let mut runner = TestRunner::new(Config {
+        cases: 200,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(&prop::collection::vec(call, 1..40), |calls| {
+            let mut f = Fmu::with(&res, "random", true);
+            for c in &calls {
+                let status = unsafe {
+                    match c {
+                        Call::Setup(t0) => {
+                            fmi2SetupExperiment(f.c, fmi2False, 0.0, *t0, fmi2False, 0.0)
+                        }
+                        Call::Enter => fmi2EnterInitializationMode(f.c),
+                        Call::Exit => fmi2ExitInitializationMode(f.c),
+                        Call::DoStep(h, right_time) => {
+                            let t = if *right_time { f.t } else { f.t + 0.5 };
+                            let s = fmi2DoStep(f.c, t, *h, fmi2False);
+                            if s == fmi2OK {
+                                f.t = t + h;
+                            }
+                            s
+                        }
+                        Call::GetReal(v, null) => {
+                            let mut x = 0.0;
+                            let out = if *null {
+                                null_mut()
+                            } else {
+                                &mut x as *mut f64
+                            };
+                            fmi2GetReal(f.c, v, 1, out)
+                        }
+                        Call::SetReal(v, x) => fmi2SetReal(f.c, v, 1, x),
+                        Call::GetInteger(v) => {
+                            let mut x = 0;
+                            fmi2GetInteger(f.c, v, 1, &mut x)
+                        }
+                        Call::SetBoolean(v, b) => {
+                            let b = *b as fmi2Boolean;
+                            fmi2SetBoolean(f.c, v, 1, &b)
+                        }
+                        Call::StateRoundTrip => {
+                            let mut state: fmi2FMUstate = null_mut();
+                            let s = fmi2GetFMUstate(f.c, &mut state);
+                            if s == fmi2OK {
+                                let _ = fmi2SetFMUstate(f.c, state);
+                                let _ = fmi2FreeFMUstate(f.c, &mut state);
+                            }
+                            s
+                        }
+                        Call::Deserialize(bytes) => {
+                            let mut state: fmi2FMUstate = null_mut();
+                            let s = fmi2DeSerializeFMUstate(
+                                f.c,
+                                bytes.as_ptr().cast(),
+                                bytes.len(),
+                                &mut state,
+                            );
+                            if !state.is_null() {
+                                let _ = fmi2FreeFMUstate(f.c, &mut state);
+                            }
+                            s
+                        }
+                        Call::Reset => {
+                            f.t = 0.0;
+                            fmi2Reset(f.c)
+                        }
+                        Call::Terminate => fmi2Terminate(f.c),
+                        Call::Status(kind) => {
+                            let mut s = fmi2OK;
+                            fmi2GetStatus(f.c, *kind, &mut s)
+                        }
+                        Call::Logging(on, k) => {
+                            let names = ["logEvents", "logAll", "nonsense", "logStatusError"];
+                            let n = CString::new(names[*k as usize % names.len()]).unwrap();
+                            let p = n.as_ptr();
+                            fmi2SetDebugLogging(f.c, *on as fmi2Boolean, *k as usize % 2, &p)
+                        }
+                        Call::Cancel => fmi2CancelStep(f.c),
+                    }
+                };
+                prop_assert!(
+                    (0..=4).contains(&(status as i32)),
+                    "{c:?} returned {status:?}"
+                );
+            }
+            Ok(())
+        })
+        .unwrap();
+    let mut fresh = Fmu::new(&res);
+    fresh.initialize();
+    assert_eq!(
+        fresh.run(20),
+        reference,
+        "a fresh instance after the random calls differs"
+    );
+}
