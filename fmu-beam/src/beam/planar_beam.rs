@@ -13,7 +13,7 @@
 use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
 use crate::scene::{BeamSpec, FrameKind};
-use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix2, Vector2};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix2, Vector2};
 
 /// Index of the angle θ in the body coordinates; q_f starts at [`FLEX`].
 pub const THETA: usize = 2;
@@ -34,6 +34,28 @@ pub struct PointMap {
     pub sp: DMatrix<f64>,
     /// Rotation of the section per q_f (1 × nf, stored as a vector).
     pub sphi: DVector<f64>,
+}
+
+/// Body coordinates (or their rates) as the beam reads them: a whole vector or a view into the
+/// system's q, without a copy.
+pub trait Coords<'a>: Into<DVectorView<'a, f64>> {}
+impl<'a, T: Into<DVectorView<'a, f64>>> Coords<'a> for T {}
+
+impl PointMap {
+    /// S_p q_f, the deformation displacement of the point.
+    pub fn displacement(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        let mut s = Vector2::zeros();
+        for k in 0..self.sp.ncols() {
+            s[0] += self.sp[(0, k)] * f[k];
+            s[1] += self.sp[(1, k)] * f[k];
+        }
+        s
+    }
+}
+
+/// Column k of a 2 × nf matrix.
+fn col2(m: &DMatrix<f64>, k: usize) -> Vector2<f64> {
+    Vector2::new(m[(0, k)], m[(1, k)])
 }
 
 /// The assembled beam: constants of eq. (11) reduced to the kept deformation coordinates.
@@ -189,48 +211,65 @@ impl PlanarBeam {
     }
 
     /// First moment c = ∫ρ ū dV = S̄_t0 + S̄ q_f in the beam frame.
-    fn first_moment(&self, f: &DVector<f64>) -> Vector2<f64> {
-        self.st0 + &self.sbar * f
+    fn first_moment(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        self.st0 + self.sbar_mul(f)
+    }
+
+    /// S̄ f for deformation coordinates or their rates.
+    fn sbar_mul(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        let mut c = Vector2::zeros();
+        for k in 0..f.len() {
+            c += col2(&self.sbar, k) * f[k];
+        }
+        c
     }
 
     /// Mass matrix M(z), written into `m` (ndof × ndof).
-    pub fn mass_matrix(&self, z: &DVector<f64>, mut m: DMatrixViewMut<f64>) {
+    pub fn mass_matrix<'a>(&self, z: impl Coords<'a>, mut m: DMatrixViewMut<f64>) {
+        let z = z.into();
         let nf = self.nflex();
-        let f = z.rows(FLEX, nf).into_owned();
+        let f = z.rows(FLEX, nf);
         let (ar, ath) = rot(z[THETA]);
         let c = self.first_moment(&f);
         let athc = ath * c;
-        let asbar = ar * &self.sbar;
-        let mff_f = &self.mff * &f;
-        let mthf = &self.b + self.w.tr_mul(&f);
         m.fill(0.0);
         m[(0, 0)] = self.mass;
         m[(1, 1)] = self.mass;
         for i in 0..2 {
             m[(i, THETA)] = athc[i];
             m[(THETA, i)] = athc[i];
-            for k in 0..nf {
-                m[(i, FLEX + k)] = asbar[(i, k)];
-                m[(FLEX + k, i)] = asbar[(i, k)];
-            }
         }
-        m[(THETA, THETA)] = self.i0 + 2.0 * self.a.dot(&f) + f.dot(&mff_f);
+        let mut mthth = self.i0;
         for k in 0..nf {
-            m[(THETA, FLEX + k)] = mthf[k];
-            m[(FLEX + k, THETA)] = mthf[k];
+            let asbar = ar * col2(&self.sbar, k);
+            for i in 0..2 {
+                m[(i, FLEX + k)] = asbar[i];
+                m[(FLEX + k, i)] = asbar[i];
+            }
+            let (mut mff_f, mut wt_f) = (0.0, 0.0);
+            for l in 0..nf {
+                mff_f += self.mff[(k, l)] * f[l];
+                wt_f += self.w[(l, k)] * f[l];
+            }
+            mthth += 2.0 * self.a[k] * f[k] + f[k] * mff_f;
+            let mthf = self.b[k] + wt_f;
+            m[(THETA, FLEX + k)] = mthf;
+            m[(FLEX + k, THETA)] = mthf;
         }
+        m[(THETA, THETA)] = mthth;
         m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);
     }
 
     /// Residual r = M z̈ + h + internal - gravity, added into `r`.
-    pub fn residual(
+    pub fn residual<'a>(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: impl Coords<'a>,
+        zd: impl Coords<'a>,
+        zdd: impl Coords<'a>,
         gravity: Vector2<f64>,
         r: &mut [f64],
     ) {
+        let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
         let fd = zd.rows(FLEX, nf);
@@ -238,49 +277,62 @@ impl PlanarBeam {
         let (ar, ath) = rot(z[THETA]);
         let (td, tdd) = (zd[THETA], zdd[THETA]);
         let rdd = Vector2::new(zdd[0], zdd[1]);
-        let c = self.st0 + &self.sbar * f;
+        let c = self.first_moment(&f);
         let (ac, athc) = (ar * c, ath * c);
-        let sbar_fd = &self.sbar * fd;
-        let sbar_fdd = &self.sbar * fdd;
-        let mff_f = &self.mff * f;
-        let af = &self.a + &mff_f; // ∫ρ Sᵀū dV
-                                   // translation
+        let sbar_fd = self.sbar_mul(&fd);
+        let sbar_fdd = self.sbar_mul(&fdd);
+        // translation
         let r_r = rdd * self.mass + athc * tdd + ar * sbar_fdd - ac * (td * td)
             + ath * sbar_fd * (2.0 * td)
             - gravity * self.mass;
         r[0] += r_r[0];
         r[1] += r_r[1];
-        // rotation
-        let mthth = self.i0 + 2.0 * self.a.dot(&f) + f.dot(&mff_f);
-        let mthf = &self.b + self.w.tr_mul(&f);
-        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf.dot(&fdd) + 2.0 * td * af.dot(&fd)
-            - athc.dot(&gravity);
-        // deformation
-        let rf =
-            self.sbar.tr_mul(&(ar.transpose() * (rdd - gravity))) + &mthf * tdd + &self.mff * fdd
-                - &af * (td * td)
-                - &self.w * fd * (2.0 * td)
-                + &self.kff * f
-                + &self.dff * fd;
+        // deformation, with the sums the rotation row needs
+        let local = ar.transpose() * (rdd - gravity);
+        let (mut a_f, mut f_mff_f, mut mthf_fdd, mut af_fd) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..nf {
-            r[FLEX + k] += rf[k];
+            let (mut mff_f, mut mff_fdd, mut wt_f, mut w_fd, mut kff_f, mut dff_fd) =
+                (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            for l in 0..nf {
+                mff_f += self.mff[(k, l)] * f[l];
+                mff_fdd += self.mff[(k, l)] * fdd[l];
+                wt_f += self.w[(l, k)] * f[l];
+                w_fd += self.w[(k, l)] * fd[l];
+                kff_f += self.kff[(k, l)] * f[l];
+                dff_fd += self.dff[(k, l)] * fd[l];
+            }
+            let mthf = self.b[k] + wt_f; // Ī_θf
+            let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
+            a_f += self.a[k] * f[k];
+            f_mff_f += f[k] * mff_f;
+            mthf_fdd += mthf * fdd[k];
+            af_fd += af * fd[k];
+            r[FLEX + k] += col2(&self.sbar, k).dot(&local) + mthf * tdd + mff_fdd
+                - af * (td * td)
+                - w_fd * (2.0 * td)
+                + kff_f
+                + dff_fd;
         }
+        // rotation
+        let mthth = self.i0 + 2.0 * a_f + f_mff_f;
+        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf_fdd + 2.0 * td * af_fd - athc.dot(&gravity);
         if self.geometric_stiffening {
-            self.stiffening_force(z, &mut r[FLEX..FLEX + nf]);
+            self.stiffening_force(&z, &mut r[FLEX..FLEX + nf]);
         }
     }
 
     /// Tangents of the residual: K_t = ∂r/∂z (at fixed ż, z̈) and C_t = ∂r/∂ż, added into the
     /// given blocks (ndof × ndof).
-    pub fn tangents(
+    pub fn tangents<'a>(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: impl Coords<'a>,
+        zd: impl Coords<'a>,
+        zdd: impl Coords<'a>,
         gravity: Vector2<f64>,
         mut kt: DMatrixViewMut<f64>,
         mut ct: DMatrixViewMut<f64>,
     ) {
+        let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
         let fd = zd.rows(FLEX, nf);
@@ -288,74 +340,75 @@ impl PlanarBeam {
         let (ar, ath) = rot(z[THETA]);
         let (td, tdd) = (zd[THETA], zdd[THETA]);
         let rdd = Vector2::new(zdd[0], zdd[1]);
-        let c = self.st0 + &self.sbar * f;
+        let c = self.first_moment(&f);
         let (ac, athc) = (ar * c, ath * c);
-        let asbar = ar * &self.sbar;
-        let athsbar = ath * &self.sbar;
-        let af = &self.a + &self.mff * f;
-        // ∂r_R/∂θ, ∂r_R/∂f
-        let d_r_th = -ac * tdd + &athsbar * fdd - athc * (td * td) - &asbar * fd * (2.0 * td);
-        let d_r_f = &athsbar * tdd - &asbar * (td * td);
+        let sbar_fd = self.sbar_mul(&fd);
+        let sbar_fdd = self.sbar_mul(&fdd);
+        // ∂r_R/∂θ
+        let d_r_th = -ac * tdd + ath * sbar_fdd - athc * (td * td) - ar * sbar_fd * (2.0 * td);
+        // ∂r_R/∂θ̇
+        let d_r_thd = -ac * (2.0 * td) + ath * sbar_fd * 2.0;
         for i in 0..2 {
             kt[(i, THETA)] += d_r_th[i];
-            for k in 0..nf {
-                kt[(i, FLEX + k)] += d_r_f[(i, k)];
-            }
+            ct[(i, THETA)] += d_r_thd[i];
         }
-        // ∂r_θ/∂θ, ∂r_θ/∂f
+        // ∂r_θ/∂θ
         kt[(THETA, THETA)] += -ac.dot(&rdd) + ac.dot(&gravity);
-        let d_th_f = athsbar.tr_mul(&(rdd - gravity))
-            + &af * (2.0 * tdd)
-            + &self.w * fdd
-            + &self.mff * fd * (2.0 * td);
-        // ∂r_f/∂θ
-        let d_f_th = athsbar.tr_mul(&(rdd - gravity));
+        let mut af_fd = 0.0;
         for k in 0..nf {
-            kt[(THETA, FLEX + k)] += d_th_f[k];
-            kt[(FLEX + k, THETA)] += d_f_th[k];
-        }
-        // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff
-        for k in 0..nf {
+            let (asbar, athsbar) = (ar * col2(&self.sbar, k), ath * col2(&self.sbar, k));
+            let (mut mff_f, mut mff_fd, mut w_fdd, mut w_fd) = (0.0, 0.0, 0.0, 0.0);
             for l in 0..nf {
+                mff_f += self.mff[(k, l)] * f[l];
+                mff_fd += self.mff[(k, l)] * fd[l];
+                w_fdd += self.w[(k, l)] * fdd[l];
+                w_fd += self.w[(k, l)] * fd[l];
+            }
+            let af = self.a[k] + mff_f;
+            af_fd += af * fd[k];
+            // ∂r_R/∂f, ∂r_R/∂ḟ
+            let d_r_f = athsbar * tdd - asbar * (td * td);
+            for i in 0..2 {
+                kt[(i, FLEX + k)] += d_r_f[i];
+                ct[(i, FLEX + k)] += 2.0 * td * athsbar[i];
+            }
+            // ∂r_θ/∂f, ∂r_f/∂θ
+            let d_f_th = athsbar.dot(&(rdd - gravity));
+            kt[(THETA, FLEX + k)] += d_f_th + af * (2.0 * tdd) + w_fdd + mff_fd * (2.0 * td);
+            kt[(FLEX + k, THETA)] += d_f_th;
+            // ∂r_θ/∂ḟ, ∂r_f/∂θ̇
+            ct[(THETA, FLEX + k)] += 2.0 * td * af;
+            ct[(FLEX + k, THETA)] += af * (-2.0 * td) - w_fd * 2.0;
+        }
+        ct[(THETA, THETA)] += 2.0 * af_fd;
+        // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff, ∂r_f/∂ḟ = -2θ̇ W + D_ff
+        for l in 0..nf {
+            for k in 0..nf {
                 kt[(FLEX + k, FLEX + l)] +=
                     self.w[(l, k)] * tdd - td * td * self.mff[(k, l)] + self.kff[(k, l)];
-            }
-        }
-        // C_t
-        let d_r_thd = -ac * (2.0 * td) + &athsbar * fd * 2.0;
-        for i in 0..2 {
-            ct[(i, THETA)] += d_r_thd[i];
-            for k in 0..nf {
-                ct[(i, FLEX + k)] += 2.0 * td * athsbar[(i, k)];
-            }
-        }
-        ct[(THETA, THETA)] += 2.0 * af.dot(&fd);
-        let d_f_thd = &af * (-2.0 * td) - &self.w * fd * 2.0;
-        for k in 0..nf {
-            ct[(THETA, FLEX + k)] += 2.0 * td * af[k];
-            ct[(FLEX + k, THETA)] += d_f_thd[k];
-            for l in 0..nf {
                 ct[(FLEX + k, FLEX + l)] += -2.0 * td * self.w[(k, l)] + self.dff[(k, l)];
             }
         }
         if self.geometric_stiffening {
-            self.stiffening_tangent(z, &mut kt);
+            self.stiffening_tangent(&z, &mut kt);
         }
     }
 
     /// Kinetic energy ½ żᵀ M ż (J).
-    pub fn kinetic_energy(&self, z: &DVector<f64>, zd: &DVector<f64>) -> f64 {
+    pub fn kinetic_energy<'a>(&self, z: impl Coords<'a>, zd: impl Coords<'a>) -> f64 {
         let n = self.ndof();
         let mut m = DMatrix::zeros(n, n);
         self.mass_matrix(z, m.view_mut((0, 0), (n, n)));
+        let zd = zd.into();
         0.5 * zd.dot(&(&m * zd))
     }
 
     /// Strain energy ½ q_fᵀ K_ff q_f (J).
-    pub fn strain_energy(&self, z: &DVector<f64>) -> f64 {
+    pub fn strain_energy<'a>(&self, z: impl Coords<'a>) -> f64 {
+        let z = z.into();
         let f = z.rows(FLEX, self.nflex());
         let extra = if self.geometric_stiffening {
-            self.stiffening_energy(z)
+            self.stiffening_energy(&z)
         } else {
             0.0
         };
@@ -363,18 +416,20 @@ impl PlanarBeam {
     }
 
     /// Potential energy of gravity -g·∫ρ r dV (J).
-    pub fn gravity_energy(&self, z: &DVector<f64>, gravity: Vector2<f64>) -> f64 {
-        let f = z.rows(FLEX, self.nflex()).into_owned();
+    pub fn gravity_energy<'a>(&self, z: impl Coords<'a>, gravity: Vector2<f64>) -> f64 {
+        let z = z.into();
+        let f = z.rows(FLEX, self.nflex());
         let (ar, _) = rot(z[THETA]);
         let com = Vector2::new(z[0], z[1]) * self.mass + ar * self.first_moment(&f);
         -gravity.dot(&com)
     }
 
     /// World position and angle of a material point map, and their Jacobians over z.
-    pub fn point(&self, map: &PointMap, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+    pub fn point<'a>(&self, map: &PointMap, z: impl Coords<'a>) -> (Vector2<f64>, f64) {
+        let z = z.into();
         let f = z.rows(FLEX, self.nflex());
         let (ar, _) = rot(z[THETA]);
-        let s = map.s0 + &map.sp * f;
+        let s = map.s0 + map.displacement(&f);
         (
             Vector2::new(z[0], z[1]) + ar * s,
             z[THETA] + map.sphi.dot(&f),
@@ -382,8 +437,8 @@ impl PlanarBeam {
     }
 
     /// Position of the map in the beam frame, s = s0 + S_p q_f.
-    pub fn local_point(&self, map: &PointMap, z: &DVector<f64>) -> Vector2<f64> {
-        map.s0 + &map.sp * z.rows(FLEX, self.nflex())
+    pub fn local_point<'a>(&self, map: &PointMap, z: impl Coords<'a>) -> Vector2<f64> {
+        map.s0 + map.displacement(&z.into().rows(FLEX, self.nflex()))
     }
 
     /// The material point at distance x from flange a along the undeformed axis.
@@ -420,7 +475,7 @@ impl PlanarBeam {
     #[allow(clippy::type_complexity)]
     fn for_element_strains(
         &self,
-        z: &DVector<f64>,
+        z: &DVectorView<f64>,
         mut visit: impl FnMut(
             &[Option<usize>; ELEMENT_DOFS],
             f64,
@@ -456,7 +511,7 @@ impl PlanarBeam {
 
     /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
     /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out`.
-    fn stiffening_force(&self, z: &DVector<f64>, out: &mut [f64]) {
+    fn stiffening_force(&self, z: &DVectorView<f64>, out: &mut [f64]) {
         let ea = self.ea;
         self.for_element_strains(z, |idx, l, eps, de, _| {
             let du =
@@ -471,7 +526,7 @@ impl PlanarBeam {
     }
 
     /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
-    fn stiffening_tangent(&self, z: &DVector<f64>, kt: &mut DMatrixViewMut<f64>) {
+    fn stiffening_tangent(&self, z: &DVectorView<f64>, kt: &mut DMatrixViewMut<f64>) {
         let ea = self.ea;
         self.for_element_strains(z, |idx, l, eps, de, hv| {
             let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
@@ -487,7 +542,7 @@ impl PlanarBeam {
     }
 
     /// Strain energy of the nonlinear strain beyond ½ q_fᵀ K_ff q_f.
-    fn stiffening_energy(&self, z: &DVector<f64>) -> f64 {
+    fn stiffening_energy(&self, z: &DVectorView<f64>) -> f64 {
         let mut e = 0.0;
         let ea = self.ea;
         self.for_element_strains(z, |idx, l, eps, _, _| {

@@ -3,7 +3,7 @@
 
 use super::rigid_body::RigidBody;
 use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, FLEX, THETA};
-use nalgebra::{DMatrixViewMut, DVector, Vector2};
+use nalgebra::{DMatrixViewMut, DVectorView, Vector2};
 
 #[derive(Debug, Clone)]
 pub enum Body {
@@ -55,7 +55,7 @@ impl Body {
         }
     }
 
-    pub fn mass_matrix(&self, z: &DVector<f64>, m: DMatrixViewMut<f64>) {
+    pub fn mass_matrix(&self, z: DVectorView<f64>, m: DMatrixViewMut<f64>) {
         match self {
             Body::Beam(b) => b.mass_matrix(z, m),
             Body::Rigid(r) => r.mass_matrix(z, m),
@@ -64,9 +64,9 @@ impl Body {
 
     pub fn residual(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
         g: Vector2<f64>,
         out: &mut [f64],
     ) {
@@ -78,9 +78,9 @@ impl Body {
 
     pub fn tangents(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
         g: Vector2<f64>,
         kt: DMatrixViewMut<f64>,
         ct: DMatrixViewMut<f64>,
@@ -91,21 +91,21 @@ impl Body {
         }
     }
 
-    pub fn kinetic_energy(&self, z: &DVector<f64>, zd: &DVector<f64>) -> f64 {
+    pub fn kinetic_energy(&self, z: DVectorView<f64>, zd: DVectorView<f64>) -> f64 {
         match self {
             Body::Beam(b) => b.kinetic_energy(z, zd),
             Body::Rigid(r) => r.kinetic_energy(z, zd),
         }
     }
 
-    pub fn strain_energy(&self, z: &DVector<f64>) -> f64 {
+    pub fn strain_energy(&self, z: DVectorView<f64>) -> f64 {
         match self {
             Body::Beam(b) => b.strain_energy(z),
             Body::Rigid(_) => 0.0,
         }
     }
 
-    pub fn gravity_energy(&self, z: &DVector<f64>, g: Vector2<f64>) -> f64 {
+    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Vector2<f64>) -> f64 {
         match self {
             Body::Beam(b) => b.gravity_energy(z, g),
             Body::Rigid(r) => r.gravity_energy(z, g),
@@ -113,17 +113,18 @@ impl Body {
     }
 
     /// Position of a material point in the body frame, s = s0 + S_p q_f.
-    pub fn local_point(&self, map: &PointMap, z: &DVector<f64>) -> Vector2<f64> {
-        map.s0 + &map.sp * z.rows(FLEX, self.nflex())
+    pub fn local_point(&self, map: &PointMap, z: DVectorView<f64>) -> Vector2<f64> {
+        map.s0 + map.displacement(&z.rows(FLEX, self.nflex()))
     }
 
     /// World position and angle of a material point.
-    pub fn point(&self, map: &PointMap, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+    pub fn point(&self, map: &PointMap, z: DVectorView<f64>) -> (Vector2<f64>, f64) {
         let (ar, _) = rot(z[THETA]);
         let s = self.local_point(map, z);
+        let f = z.rows(FLEX, self.nflex());
         (
             Vector2::new(z[0], z[1]) + ar * s,
-            z[THETA] + map.sphi.dot(&z.rows(FLEX, self.nflex())),
+            z[THETA] + map.sphi.dot(&f),
         )
     }
 }

@@ -5,15 +5,17 @@ use super::frame::FrameState;
 use super::law::{InputValue, TimeLaw};
 use super::{prismatic, revolute, weld};
 use crate::scene::{DriveKind, JointKind};
-use nalgebra::{DVector, Vector2};
+use nalgebra::Vector2;
 
-/// One constraint equation between frames 0 and 1.
-#[derive(Debug, Clone)]
+/// One constraint equation between frames 0 and 1. Its Jacobian on the body of frame i is
+/// J_pᵀ w_i + J_φ c_i (see [`FrameState::for_each_jacobian`]).
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Row {
     pub g: f64,
-    /// ∂g/∂z on the bodies of frame 0 and frame 1.
-    pub j0: DVector<f64>,
-    pub j1: DVector<f64>,
+    pub w0: Vector2<f64>,
+    pub c0: f64,
+    pub w1: Vector2<f64>,
+    pub c1: f64,
     /// g'' = J q'' + bias.
     pub bias: f64,
     /// World direction of the reaction on frame 1 (frame 0 gets the opposite), for the
@@ -26,8 +28,10 @@ impl Row {
     pub fn along(f0: &FrameState, f1: &FrameState, d: Vector2<f64>) -> Row {
         Row {
             g: d.dot(&(f1.p - f0.p)),
-            j0: -f0.jp.tr_mul(&d),
-            j1: f1.jp.tr_mul(&d),
+            w0: -d,
+            c0: 0.0,
+            w1: d,
+            c1: 0.0,
             bias: d.dot(&(f1.bias_p - f0.bias_p)),
             force_dir: Some(d),
         }
@@ -41,12 +45,12 @@ impl Row {
         let d = f1.p - f0.p;
         let dd = f1.pd - f0.pd;
         let w = f0.phid;
-        let mut j0 = -f0.jp.tr_mul(&dir);
-        j0 += &f0.jphi * ddir.dot(&d);
         Row {
             g: dir.dot(&d),
-            j0,
-            j1: f1.jp.tr_mul(&dir),
+            w0: -dir,
+            c0: ddir.dot(&d),
+            w1: dir,
+            c1: 0.0,
             bias: dir.dot(&(f1.bias_p - f0.bias_p)) + 2.0 * w * ddir.dot(&dd) - w * w * dir.dot(&d),
             force_dir: Some(dir),
         }
@@ -56,11 +60,34 @@ impl Row {
     pub fn angle(f0: &FrameState, f1: &FrameState, offset: f64) -> Row {
         Row {
             g: f1.phi - f0.phi - offset,
-            j0: -&f0.jphi,
-            j1: f1.jphi.clone(),
+            w0: Vector2::zeros(),
+            c0: -1.0,
+            w1: Vector2::zeros(),
+            c1: 1.0,
             bias: 0.0,
             force_dir: None,
         }
+    }
+}
+
+/// The rows of one joint (at most 3), without allocation.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Rows {
+    rows: [Row; 3],
+    len: usize,
+}
+
+impl Rows {
+    pub fn push(&mut self, r: Row) {
+        self.rows[self.len] = r;
+        self.len += 1;
+    }
+}
+
+impl std::ops::Deref for Rows {
+    type Target = [Row];
+    fn deref(&self) -> &[Row] {
+        &self.rows[..self.len]
     }
 }
 
@@ -103,13 +130,7 @@ impl Joint {
     }
 
     /// All rows at time t.
-    pub fn rows(
-        &self,
-        f0: &FrameState,
-        f1: &FrameState,
-        t: f64,
-        inputs: &[InputValue],
-    ) -> Vec<Row> {
+    pub fn rows(&self, f0: &FrameState, f1: &FrameState, t: f64, inputs: &[InputValue]) -> Rows {
         let mut rows = match self.kind {
             JointKind::Weld => weld::rows(f0, f1, self.angle_offset),
             JointKind::Revolute => revolute::rows(f0, f1),

@@ -2,7 +2,7 @@
 //! its relative angle (2 equations); e·(p₁ - p₀) is the joint position.
 
 use super::frame::FrameState;
-use super::joint::Row;
+use super::joint::{Row, Rows};
 use nalgebra::Vector2;
 
 /// Axis e and normal n of the slide in world components.
@@ -12,9 +12,9 @@ pub fn axes(f0: &FrameState, axis_angle: f64) -> (Vector2<f64>, Vector2<f64>) {
 }
 
 /// g = [n·(p₁ - p₀); φ₁ - φ₀ - offset].
-pub fn rows(f0: &FrameState, f1: &FrameState, axis_angle: f64, offset: f64) -> Vec<Row> {
-    vec![
-        Row::along_rotating(f0, f1, axis_angle, true),
-        Row::angle(f0, f1, offset),
-    ]
+pub fn rows(f0: &FrameState, f1: &FrameState, axis_angle: f64, offset: f64) -> Rows {
+    let mut rows = Rows::default();
+    rows.push(Row::along_rotating(f0, f1, axis_angle, true));
+    rows.push(Row::angle(f0, f1, offset));
+    rows
 }

@@ -2,13 +2,13 @@
 //! φ₁ - φ₀ is the joint angle.
 
 use super::frame::FrameState;
-use super::joint::Row;
+use super::joint::{Row, Rows};
 use nalgebra::Vector2;
 
 /// g = p₁ - p₀.
-pub fn rows(f0: &FrameState, f1: &FrameState) -> Vec<Row> {
-    [Vector2::x(), Vector2::y()]
-        .into_iter()
-        .map(|d| Row::along(f0, f1, d))
-        .collect()
+pub fn rows(f0: &FrameState, f1: &FrameState) -> Rows {
+    let mut rows = Rows::default();
+    rows.push(Row::along(f0, f1, Vector2::x()));
+    rows.push(Row::along(f0, f1, Vector2::y()));
+    rows
 }

@@ -3,7 +3,7 @@
 //! (the massless slider of case C3): its block of the mass matrix is zero.
 
 use crate::beam::planar_beam::{rot, PointMap};
-use nalgebra::{DMatrix, DMatrixViewMut, DVector, Vector2};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Vector2};
 
 #[derive(Debug, Clone)]
 pub struct RigidBody {
@@ -37,7 +37,7 @@ impl RigidBody {
     }
 
     /// M(z) = [[m I, m A_φ c̄], [·, J_c + m |c̄|²]].
-    pub fn mass_matrix(&self, z: &DVector<f64>, mut m: DMatrixViewMut<f64>) {
+    pub fn mass_matrix(&self, z: DVectorView<f64>, mut m: DMatrixViewMut<f64>) {
         let (_, ath) = rot(z[2]);
         let mc = ath * self.com * self.mass;
         m.fill(0.0);
@@ -53,9 +53,9 @@ impl RigidBody {
     /// r = M z̈ + h - Q_g, with h_R = -φ̇² A c̄ m.
     pub fn residual(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
         g: Vector2<f64>,
         r: &mut [f64],
     ) {
@@ -74,9 +74,9 @@ impl RigidBody {
     /// K_t = ∂r/∂z and C_t = ∂r/∂ż, added.
     pub fn tangents(
         &self,
-        z: &DVector<f64>,
-        zd: &DVector<f64>,
-        zdd: &DVector<f64>,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
         g: Vector2<f64>,
         mut kt: DMatrixViewMut<f64>,
         mut ct: DMatrixViewMut<f64>,
@@ -93,13 +93,13 @@ impl RigidBody {
         kt[(2, 2)] += -(ar * c).dot(&(Vector2::new(zdd[0], zdd[1]) - g));
     }
 
-    pub fn kinetic_energy(&self, z: &DVector<f64>, zd: &DVector<f64>) -> f64 {
+    pub fn kinetic_energy(&self, z: DVectorView<f64>, zd: DVectorView<f64>) -> f64 {
         let mut m = DMatrix::zeros(3, 3);
         self.mass_matrix(z, m.view_mut((0, 0), (3, 3)));
         0.5 * zd.dot(&(&m * zd))
     }
 
-    pub fn gravity_energy(&self, z: &DVector<f64>, g: Vector2<f64>) -> f64 {
+    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Vector2<f64>) -> f64 {
         let (ar, _) = rot(z[2]);
         -g.dot(&((Vector2::new(z[0], z[1]) + ar * self.com) * self.mass))
     }

@@ -5,13 +5,13 @@
 
 use super::body::Body;
 use super::frame::{self, Frame, FrameState};
-use super::joint::{Drive, Joint, Row};
+use super::joint::{Drive, Joint, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
 use crate::beam::planar_beam::{rot, PlanarBeam, PointMap};
 use crate::error::EngineError;
 use crate::scene::{DriveKind, JointKind, Scene};
-use nalgebra::{DMatrix, DVector, Vector2};
+use nalgebra::{DMatrix, DVector, DVectorView, Vector2};
 use std::ops::Range;
 
 /// Energies of the system (J).
@@ -216,7 +216,6 @@ impl System {
             m: 0,
         };
         let q0 = sys.placed_coordinates(scene);
-        let v0 = DVector::zeros(n);
         // substructure welds: flange b of each frame to flange a of the next
         let mut internal = Vec::new();
         for g in sys.beams.clone() {
@@ -238,7 +237,7 @@ impl System {
         }
         let mut row = 0;
         for (name, f0, f1) in internal {
-            let offset = sys.relative_angle(f0, f1, &q0, &v0);
+            let offset = sys.relative_angle(f0, f1, &q0);
             sys.joints.push(Joint {
                 name,
                 kind: JointKind::Weld,
@@ -263,7 +262,7 @@ impl System {
                         .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
                 ),
             });
-            let offset = sys.relative_angle(f0, f1, &q0, &v0);
+            let offset = sys.relative_angle(f0, f1, &q0);
             let count = Joint::rows_count(j.kind, drive.as_ref());
             sys.joints.push(Joint {
                 name: j.name.clone(),
@@ -339,8 +338,8 @@ impl System {
         self.add_frame(frame)
     }
 
-    fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>, v: &DVector<f64>) -> f64 {
-        self.frame_state(f1, q, v).phi - self.frame_state(f0, q, v).phi
+    fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>) -> f64 {
+        self.frame_state(f1, q, None).phi - self.frame_state(f0, q, None).phi
     }
 
     /// Number of coordinates.
@@ -376,8 +375,8 @@ impl System {
     }
 
     /// Coordinates of body `i`.
-    pub fn body_coords(&self, i: usize, q: &DVector<f64>) -> DVector<f64> {
-        q.rows(self.offsets[i], self.bodies[i].ndof()).into_owned()
+    pub fn body_coords<'a>(&self, i: usize, q: &'a DVector<f64>) -> DVectorView<'a, f64> {
+        q.rows(self.offsets[i], self.bodies[i].ndof())
     }
 
     /// Coordinates of the scene's placement, before assembly: frames where the scene puts
@@ -431,28 +430,33 @@ impl System {
         Ok(q)
     }
 
-    /// Kinematics of frame `f`.
-    pub fn frame_state(&self, f: usize, q: &DVector<f64>, v: &DVector<f64>) -> FrameState {
+    /// Kinematics of frame `f` (at rest without rates).
+    pub fn frame_state(
+        &self,
+        f: usize,
+        q: &DVector<f64>,
+        v: Option<&DVector<f64>>,
+    ) -> FrameState<'_> {
         match &self.frames[f] {
             Frame::World { position, angle } => FrameState::world(*position, *angle),
             Frame::OnBody { body, map } => FrameState::on_body(
                 *body,
                 &self.bodies[*body],
                 map,
-                &self.body_coords(*body, q),
-                &self.body_coords(*body, v),
+                self.body_coords(*body, q),
+                v.map(|v| self.body_coords(*body, v)),
             ),
         }
     }
 
-    /// The rows of joint `j` at (q, q', t).
+    /// The rows of joint `j` at (q, q', t) (at rest without rates).
     pub fn joint_rows(
         &self,
         j: &Joint,
         q: &DVector<f64>,
-        v: &DVector<f64>,
+        v: Option<&DVector<f64>>,
         t: f64,
-    ) -> (FrameState, FrameState, Vec<Row>) {
+    ) -> (FrameState<'_>, FrameState<'_>, Rows) {
         let f0 = self.frame_state(j.frames[0], q, v);
         let f1 = self.frame_state(j.frames[1], q, v);
         let rows = j.rows(&f0, &f1, t, &self.inputs);
@@ -461,37 +465,56 @@ impl System {
 
     /// Constraint residual g(q, t).
     pub fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
-        let v = DVector::zeros(self.n);
         for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, &v, t);
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
             for (k, r) in rows.iter().enumerate() {
                 g[j.row + k] = r.g;
             }
         }
     }
 
+    /// Adds J_pᵀ w + J_φ c of frame `f` into row `row` of `out`.
     fn add_row_jacobian(
         &self,
         out: &mut DMatrix<f64>,
         row: usize,
         f: &FrameState,
-        jac: &DVector<f64>,
+        w: Vector2<f64>,
+        c: f64,
     ) {
         if let Some(b) = f.body {
-            let mut dst = out.view_mut((row, self.offsets[b]), (1, jac.len()));
-            dst += jac.transpose();
+            let o = self.offsets[b];
+            f.for_each_jacobian(w, c, |k, x| out[(row, o + k)] += x);
         }
     }
 
     /// Constraint Jacobian G = ∂g/∂q (m × n), overwritten.
     pub fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
         g.fill(0.0);
-        let v = DVector::zeros(self.n);
         for j in &self.joints {
-            let (f0, f1, rows) = self.joint_rows(j, q, &v, t);
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
             for (k, r) in rows.iter().enumerate() {
-                self.add_row_jacobian(g, j.row + k, &f0, &r.j0);
-                self.add_row_jacobian(g, j.row + k, &f1, &r.j1);
+                self.add_row_jacobian(g, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(g, j.row + k, &f1, r.w1, r.c1);
+            }
+        }
+    }
+
+    /// Constraint residual g(q, t) and Jacobian G (overwritten) in one pass over the joints.
+    pub fn constraints_and_jacobian(
+        &self,
+        q: &DVector<f64>,
+        t: f64,
+        g: &mut DVector<f64>,
+        gm: &mut DMatrix<f64>,
+    ) {
+        gm.fill(0.0);
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
+                self.add_row_jacobian(gm, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(gm, j.row + k, &f1, r.w1, r.c1);
             }
         }
     }
@@ -499,7 +522,7 @@ impl System {
     /// Acceleration bias: d²g/dt² = G q'' + bias.
     pub fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
         for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, v, t);
+            let (_, _, rows) = self.joint_rows(j, q, Some(v), t);
             for (k, r) in rows.iter().enumerate() {
                 out[j.row + k] = r.bias;
             }
@@ -512,7 +535,7 @@ impl System {
         for (i, b) in self.bodies.iter().enumerate() {
             let o = self.offsets[i];
             b.mass_matrix(
-                &self.body_coords(i, q),
+                self.body_coords(i, q),
                 m.view_mut((o, o), (b.ndof(), b.ndof())),
             );
         }
@@ -536,16 +559,11 @@ impl System {
         u.value + u.der1 * dt + 0.5 * u.der2 * dt * dt
     }
 
-    fn add_generalized_force(
-        &self,
-        r: &mut DVector<f64>,
-        f: &FrameState,
-        gen: &DVector<f64>,
-        scale: f64,
-    ) {
+    /// Subtracts the generalized force J_pᵀ w + J_φ c of frame `f` from the residual.
+    fn add_generalized_force(&self, r: &mut DVector<f64>, f: &FrameState, w: Vector2<f64>, c: f64) {
         if let Some(b) = f.body {
-            let mut dst = r.rows_mut(self.offsets[b], gen.len());
-            dst.axpy(-scale, gen, 1.0);
+            let o = self.offsets[b];
+            f.for_each_jacobian(w, c, |k, x| r[o + k] -= x);
         }
     }
 
@@ -563,26 +581,25 @@ impl System {
             let o = self.offsets[i];
             let n = b.ndof();
             b.residual(
-                &self.body_coords(i, q),
-                &self.body_coords(i, v),
-                &self.body_coords(i, a),
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
                 self.gravity,
                 &mut r.as_mut_slice()[o..o + n],
             );
         }
         for l in &self.loads {
-            let fs = self.frame_state(l.frame, q, v);
+            let fs = self.frame_state(l.frame, q, None);
             let (force, torque) = self.load_value(l, t);
-            let gen = fs.jp.tr_mul(&force) + &fs.jphi * torque;
-            self.add_generalized_force(r, &fs, &gen, 1.0);
+            self.add_generalized_force(r, &fs, force, torque);
         }
         for j in &self.joints {
             if let Some(effort) = j.effort(t, &self.inputs) {
-                let f0 = self.frame_state(j.frames[0], q, v);
-                let f1 = self.frame_state(j.frames[1], q, v);
+                let f0 = self.frame_state(j.frames[0], q, Some(v));
+                let f1 = self.frame_state(j.frames[1], q, Some(v));
                 let c = j.coordinate(&f0, &f1);
-                self.add_generalized_force(r, &f0, &c.j0, effort);
-                self.add_generalized_force(r, &f1, &c.j1, effort);
+                self.add_generalized_force(r, &f0, c.w0 * effort, c.c0 * effort);
+                self.add_generalized_force(r, &f1, c.w1 * effort, c.c1 * effort);
             }
         }
     }
@@ -600,7 +617,7 @@ impl System {
             frame::add_force_tangent(
                 b,
                 map,
-                &self.body_coords(*body, q),
+                self.body_coords(*body, q),
                 force,
                 kt.view_mut((o, o), (b.ndof(), b.ndof())),
             );
@@ -626,16 +643,16 @@ impl System {
             let o = self.offsets[i];
             let n = b.ndof();
             b.tangents(
-                &self.body_coords(i, q),
-                &self.body_coords(i, v),
-                &self.body_coords(i, a),
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
                 self.gravity,
                 kt.view_mut((o, o), (n, n)),
                 ct.view_mut((o, o), (n, n)),
             );
         }
         for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, v, t);
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
             for (k, r) in rows.iter().enumerate() {
                 if let Some(d) = r.force_dir {
                     let l = lambda[j.row + k];
@@ -655,9 +672,9 @@ impl System {
         let mut e = Energy::default();
         for (i, b) in self.bodies.iter().enumerate() {
             let z = self.body_coords(i, q);
-            e.kinetic += b.kinetic_energy(&z, &self.body_coords(i, v));
-            e.strain += b.strain_energy(&z);
-            e.potential += b.gravity_energy(&z, self.gravity);
+            e.kinetic += b.kinetic_energy(z, self.body_coords(i, v));
+            e.strain += b.strain_energy(z);
+            e.potential += b.gravity_energy(z, self.gravity);
         }
         e
     }
@@ -691,13 +708,14 @@ impl System {
     /// Joint coordinate (rad or m) and its rate.
     pub fn joint_coordinate(&self, j: usize, q: &DVector<f64>, v: &DVector<f64>) -> (f64, f64) {
         let jt = &self.joints[j];
-        let f0 = self.frame_state(jt.frames[0], q, v);
-        let f1 = self.frame_state(jt.frames[1], q, v);
+        let f0 = self.frame_state(jt.frames[0], q, Some(v));
+        let f1 = self.frame_state(jt.frames[1], q, Some(v));
         let c = jt.coordinate(&f0, &f1);
-        let body_rate = |f: &FrameState, jac: &DVector<f64>| {
-            f.body.map_or(0.0, |b| jac.dot(&self.body_coords(b, v)))
+        let body_rate = |f: &FrameState, w, c| {
+            f.body
+                .map_or(0.0, |b| f.jacobian_dot(w, c, self.body_coords(b, v)))
         };
-        (c.g, body_rate(&f0, &c.j0) + body_rate(&f1, &c.j1))
+        (c.g, body_rate(&f0, c.w0, c.c0) + body_rate(&f1, c.w1, c.c1))
     }
 
     /// Torque (revolute) or force (prismatic) that the joint's drive applies across the joint:
@@ -723,7 +741,7 @@ impl System {
             }
         }
         for l in &self.loads {
-            let fs = self.frame_state(l.frame, q, v);
+            let fs = self.frame_state(l.frame, q, Some(v));
             let (force, torque) = self.load_value(l, t);
             p += force.dot(&fs.pd) + torque * fs.phid;
         }
@@ -741,8 +759,8 @@ impl System {
         let last = grp.bodies.end - 1;
         let z = self.body_coords(last, q);
         match &self.bodies[last] {
-            Body::Beam(b) => b.point(&b.flange_b, &z),
-            Body::Rigid(r) => r_point(r, "b", &z),
+            Body::Beam(b) => b.point(&b.flange_b, z),
+            Body::Rigid(r) => r_point(r, "b", z),
         }
     }
 
@@ -771,11 +789,11 @@ impl System {
     /// World position of the beam's mid-span point.
     pub fn beam_mid(&self, g: usize, q: &DVector<f64>) -> Vector2<f64> {
         let (body, map) = &self.beams[g].mid;
-        self.bodies[*body].point(map, &self.body_coords(*body, q)).0
+        self.bodies[*body].point(map, self.body_coords(*body, q)).0
     }
 }
 
-fn r_point(r: &RigidBody, frame: &str, z: &DVector<f64>) -> (Vector2<f64>, f64) {
+fn r_point(r: &RigidBody, frame: &str, z: DVectorView<f64>) -> (Vector2<f64>, f64) {
     let map = r
         .frame_map(frame)
         .unwrap_or_else(|| r.frame_map("origin").expect("origin"));

@@ -3,10 +3,10 @@
 //! welded tip to root (planar paper §3.4).
 
 use super::frame::FrameState;
-use super::joint::Row;
+use super::joint::{Row, Rows};
 
 /// g = [p₁ - p₀; φ₁ - φ₀ - offset].
-pub fn rows(f0: &FrameState, f1: &FrameState, offset: f64) -> Vec<Row> {
+pub fn rows(f0: &FrameState, f1: &FrameState, offset: f64) -> Rows {
     let mut rows = super::revolute::rows(f0, f1);
     rows.push(Row::angle(f0, f1, offset));
     rows
