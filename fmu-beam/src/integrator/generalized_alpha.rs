@@ -151,11 +151,10 @@ impl Stepper {
     }
 
     /// Weighted RMS norm of a position-like vector against the tolerance.
-    fn norm(&self, dq: &DVector<f64>, q: &DVector<f64>) -> f64 {
+    fn norm<'a>(&self, dq: impl Iterator<Item = &'a f64>, q: &DVector<f64>) -> f64 {
         let tol = self.settings.tolerance;
-        let n = dq.len().max(1) as f64;
+        let n = q.len().max(1) as f64;
         let s: f64 = dq
-            .iter()
             .zip(q.iter())
             .zip(self.scale.iter())
             .map(|((d, x), sc)| {
@@ -313,15 +312,17 @@ impl Stepper {
         sys.mass_matrix(q, &mut self.mm);
         sys.tangents(q, v, qdd, lambda, t, &mut self.kt, &mut self.ct);
         sys.constraint_jacobian(q, t, &mut self.gm);
-        let mut top = self.jac.view_mut((0, 0), (n, n));
-        top.copy_from(&self.kt);
-        top *= d;
-        top += &self.mm * (beta_p * d);
-        top += &self.ct * (gamma_p * d);
-        self.jac
-            .view_mut((0, n), (n, m))
-            .copy_from(&self.gm.transpose());
-        self.jac.view_mut((n, 0), (m, n)).copy_from(&self.gm);
+        let (cm, cc) = (beta_p * d, gamma_p * d);
+        for j in 0..n {
+            for i in 0..n {
+                self.jac[(i, j)] =
+                    self.kt[(i, j)] * d + self.mm[(i, j)] * cm + self.ct[(i, j)] * cc;
+            }
+            for k in 0..m {
+                self.jac[(n + k, j)] = self.gm[(k, j)];
+                self.jac[(j, n + k)] = self.gm[(k, j)];
+            }
+        }
         self.jac.view_mut((n, n), (m, m)).fill(0.0);
         stats.jacobians += 1;
         let lu = self.jac.clone().lu();
@@ -369,20 +370,23 @@ impl Stepper {
                 fresh = true;
             }
             sys.body_residual(&q, &v, &qdd, t_new, &mut self.r);
-            sys.constraint_jacobian(&q, t_new, &mut self.gm);
+            sys.constraints_and_jacobian(&q, t_new, &mut self.g, &mut self.gm);
             self.r.gemv_tr(1.0, &self.gm, &lambda, 1.0);
-            sys.constraints(&q, t_new, &mut self.g);
-            self.rhs.rows_mut(0, n).copy_from(&(&self.r * (-d)));
-            self.rhs.rows_mut(n, m).copy_from(&(-&self.g));
+            for i in 0..n {
+                self.rhs[i] = -d * self.r[i];
+            }
+            for k in 0..m {
+                self.rhs[n + k] = -self.g[k];
+            }
             let lu = self.lu.as_ref().ok_or(Failure::Singular)?;
             if !lu.solve_mut(&mut self.rhs) {
                 return Err(Failure::Singular);
             }
             stats.newton_iterations += 1;
-            let dq = self.rhs.rows(0, n).into_owned();
-            q += &dq;
-            v += &dq * gamma_p;
-            qdd += &dq * beta_p;
+            let dq = self.rhs.rows(0, n);
+            q += dq;
+            v.axpy(gamma_p, &dq, 1.0);
+            qdd.axpy(beta_p, &dq, 1.0);
             for k in 0..m {
                 lambda[k] += self.rhs[n + k] / d;
             }
@@ -390,7 +394,7 @@ impl Stepper {
                 self.lu = None;
                 return Err(Failure::NonFinite);
             }
-            norm = self.norm(&dq, &q);
+            norm = self.norm(dq.iter(), &q);
             let rate = norm / prev;
             let converged = norm <= NEWTON_KAPPA
                 || (it > 0 && rate < 1.0 && norm * rate / (1.0 - rate) <= NEWTON_KAPPA);
@@ -405,7 +409,7 @@ impl Stepper {
                     qdd[k] = 0.0;
                 }
                 let err = (c.beta - 1.0 / 6.0).abs() * h * h;
-                let err = self.norm(&((&acc - &st.acc) * err), &q);
+                let err = self.norm(((&acc - &st.acc) * err).iter(), &q);
                 if rate > 0.5 && it > 0 {
                     self.lu = None; // slow: refresh for the next step
                 }
