@@ -1,6 +1,9 @@
 /* A minimal FMI 2.0 co-simulation master in C for the leak test: loads an extracted FMU's
  * binary with dlopen and runs N cycles of instantiate / initialize / doStep / free.
- * Usage: leak_cycles <binary.so> <resources file URI> <GUID> <cycles> */
+ * Usage: leak_cycles <binary.so> <resources file URI> <GUID> <cycles>
+ *        leak_cycles <binary.so> <resources file URI> <GUID> steps <n>
+ * The second form runs one instance for n fmi2DoStep calls and prints the resident memory
+ * (KiB) after n/10 and after n calls. */
 #include <dlfcn.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -25,8 +28,16 @@ static void logger(void *env, const char *name, int status, const char *category
     var = dlsym(lib, name);                                               \
     if (!var) { fprintf(stderr, "missing %s\n", name); return 2; }
 
+static long rss_kib(void) {
+    long pages = 0, resident = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (!f || fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = -1;
+    if (f) fclose(f);
+    return resident * 4;
+}
+
 int main(int argc, char **argv) {
-    if (argc != 5) { fprintf(stderr, "usage: %s lib uri guid cycles\n", argv[0]); return 2; }
+    if (argc != 5 && argc != 6) { fprintf(stderr, "usage: %s lib uri guid cycles | steps n\n", argv[0]); return 2; }
     void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (!lib) { fprintf(stderr, "%s\n", dlerror()); return 2; }
     Component (*instantiate)(const char *, int, const char *, const char *, const Callbacks *, int, int);
@@ -42,6 +53,18 @@ int main(int argc, char **argv) {
     LOAD(terminate, "fmi2Terminate");
     LOAD(free_instance, "fmi2FreeInstance");
     Callbacks cb = {logger, calloc, free, NULL, NULL};
+    if (argc == 6) {
+        long n = atol(argv[5]), before = 0;
+        Component c = instantiate("steps", 1, argv[3], argv[2], &cb, 0, 0);
+        if (!c || setup(c, 0, 0.0, 0, 0.0, 0) || enter(c) || exit_init(c)) return 1;
+        for (long k = 0; k < n; k++) {
+            if (do_step(c, k * 1e-4, 1e-4, 1)) { fprintf(stderr, "doStep failed at %ld\n", k); return 1; }
+            if (k == n / 10) before = rss_kib();
+        }
+        printf("rss %ld %ld\n", before, rss_kib());
+        free_instance(c);
+        return 0;
+    }
     int cycles = atoi(argv[4]);
     for (int k = 0; k < cycles; k++) {
         Component c = instantiate("leak", 1, argv[3], argv[2], &cb, 0, 0);
