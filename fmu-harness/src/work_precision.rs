@@ -73,6 +73,9 @@ pub const CASES: &[Case] = &[
     },
 ];
 
+/// The tolerance that stops Newton in fixed-step runs.
+pub const FIXED_STEP_NEWTON_TOLERANCE: f64 = 1e-10;
+
 /// How the integrator is set for one point: error control at a tolerance, or a fixed step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Setting {
@@ -130,6 +133,10 @@ fn simulate(scene: &Scene, case: &Case, setting: Setting) -> Result<Series, Harn
             e.set_boolean(adaptive, false).map_err(fail)?;
             let max_step = vr(&e, "solver.max_step").expect("every scene has solver.max_step");
             e.set_real(max_step, h).map_err(fail)?;
+            // with a fixed step the tolerance only stops Newton: tight, so that the step
+            // alone sets the error (a loose Newton error accumulates over thousands of steps)
+            let tol = vr(&e, "solver.tolerance").expect("every scene has solver.tolerance");
+            e.set_real(tol, FIXED_STEP_NEWTON_TOLERANCE).map_err(fail)?;
         }
     }
     e.exit_initialization().map_err(fail)?;
