@@ -61,6 +61,7 @@ check:
 bench: .venv fmus
 	$(PY) tests/bench_c1.py
 	$(HARNESS) work-precision --scenes scenes --output build/bench
+	$(PY) tests/plot_work_precision.py build/bench/work_precision.csv
 
 clean:
 	rm -rf build .pytest_cache tests/__pycache__
