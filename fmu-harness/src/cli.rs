@@ -1,7 +1,7 @@
-//! The command line: `package`, `modes` and `work-precision`.
+//! The command line: `package`, `modes`, `work-precision` and `simulate`.
 
 use crate::error::HarnessError;
-use crate::{modes, package, work_precision};
+use crate::{modes, package, simulate, work_precision};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -38,6 +38,24 @@ pub enum Command {
         /// How many modes to print.
         #[arg(long, default_value_t = 10)]
         count: usize,
+    },
+    /// Run one FMI 2.0 co-simulation FMU (any, not only ours) with a fixed communication step
+    /// and write the chosen variables at every communication point as CSV (time first).
+    Simulate {
+        /// The FMU.
+        fmu: PathBuf,
+        /// Stop time [default: the DefaultExperiment's].
+        #[arg(long)]
+        stop: Option<f64>,
+        /// Communication step [default: the DefaultExperiment's stepSize].
+        #[arg(long)]
+        step: Option<f64>,
+        /// Variables to record [default: every output].
+        #[arg(long, value_delimiter = ',')]
+        output: Vec<String>,
+        /// The CSV file to write [default: standard output].
+        #[arg(short = 'o', long = "csv")]
+        csv: Option<PathBuf>,
     },
     /// Work-precision study of the validation cases (error against a tight-tolerance reference
     /// versus time, over the integrator tolerance); writes work_precision.csv and .md.
@@ -116,6 +134,25 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             )?;
             for path in work_precision::write(&output, &points)? {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
+            }
+        }
+        Command::Simulate {
+            fmu,
+            stop,
+            step,
+            output,
+            csv,
+        } => {
+            let options = simulate::Options {
+                stop_time: stop,
+                step,
+                outputs: output,
+            };
+            let text = simulate::simulate(&fmu, &options)?.csv();
+            match csv {
+                Some(path) => std::fs::write(&path, text)
+                    .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?,
+                None => out.write_all(text.as_bytes()).map_err(stdout_err)?,
             }
         }
         Command::Modes { scene, count } => {

@@ -42,6 +42,8 @@ pub enum HarnessError {
     },
     #[error("scene `{scene}`: its canonical text for resources/scene.toml is unusable: {message}")]
     CanonicalScene { scene: String, message: String },
+    #[error(transparent)]
+    Simulate(#[from] crate::simulate::SimulateError),
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
     BadOutput { path: PathBuf },
 }

@@ -1,5 +1,6 @@
-//! fmu-harness: turns a scene file into an FMI 2.0 co-simulation FMU, and reports a scene's
-//! linearized natural frequencies.
+//! fmu-harness: turns a scene file into an FMI 2.0 co-simulation FMU, reports a scene's
+//! linearized natural frequencies, and runs FMI 2.0 co-simulation FMUs (any, not only ours)
+//! through [`slave::Slave`] over the raw binding [`fmi2_binding`] (the crate's only unsafe code).
 //!
 //! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::variables::VariableTable`] →
 //! [`model_description::render`] (the template in `modelDescription-templates/`) →
@@ -8,11 +9,15 @@
 pub mod archive;
 pub mod cli;
 pub mod error;
+#[allow(unsafe_code)]
+pub mod fmi2_binding;
 pub mod guid;
 pub mod log_categories;
 pub mod model_description;
 pub mod modes;
 pub mod package;
+pub mod simulate;
+pub mod slave;
 pub mod template;
 pub mod work_precision;
 

@@ -1,0 +1,607 @@
+//! The raw FMI 2.0 co-simulation binding: the C types and function pointer types of
+//! `fmi2TypesPlatform.h` / `fmi2FunctionTypes.h` that the master uses, loaded with `libloading`
+//! from `binaries/linux64/<modelIdentifier>.so`, and an [`Instance`] whose methods call them one
+//! to one (slices instead of pointer + length, status as [`Status`]).
+//!
+//! The one module of fmu-harness with unsafe code. What it guarantees to the safe code above it:
+//! an [`Instance`] owns its component, its callback struct and its log sink, which outlive every
+//! call and are freed after `fmi2FreeInstance`; the library stays loaded while an instance lives;
+//! array lengths passed to C are the slice lengths; an [`FmuState`] is only ever handed back to
+//! the instance that made it.
+
+#![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
+
+use std::ffi::CStr;
+use std::os::raw::{c_char, c_int, c_uint, c_void};
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+pub type fmi2Component = *mut c_void;
+pub type fmi2ComponentEnvironment = *mut c_void;
+pub type fmi2FMUstate = *mut c_void;
+pub type fmi2ValueReference = c_uint;
+pub type fmi2Real = f64;
+pub type fmi2Integer = c_int;
+pub type fmi2Boolean = c_int;
+pub type fmi2String = *const c_char;
+pub type fmi2Status = c_int;
+pub type fmi2Type = c_int;
+
+pub const fmi2True: fmi2Boolean = 1;
+pub const fmi2False: fmi2Boolean = 0;
+pub const fmi2CoSimulation: fmi2Type = 1;
+
+/// `fmi2CallbackLogger` without its variadic tail. C declares it `(env, name, status, category,
+/// message, ...)`; a stable Rust `extern "C" fn` cannot be variadic, so the master's logger takes
+/// the fixed arguments only and `message` is shown as it comes. Our FMUs double every `%`, so
+/// their messages carry no directives; a foreign FMU's printf-style arguments are not expanded
+/// (the message keeps its `%d`, `%s`, ...).
+pub type fmi2CallbackLogger =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
+pub type fmi2CallbackAllocateMemory = unsafe extern "C" fn(usize, usize) -> *mut c_void;
+pub type fmi2CallbackFreeMemory = unsafe extern "C" fn(*mut c_void);
+pub type fmi2StepFinished = unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status);
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+pub struct fmi2CallbackFunctions {
+    pub logger: Option<fmi2CallbackLogger>,
+    pub allocateMemory: Option<fmi2CallbackAllocateMemory>,
+    pub freeMemory: Option<fmi2CallbackFreeMemory>,
+    pub stepFinished: Option<fmi2StepFinished>,
+    pub componentEnvironment: fmi2ComponentEnvironment,
+}
+
+pub type fmi2InstantiateTYPE = unsafe extern "C" fn(
+    fmi2String,
+    fmi2Type,
+    fmi2String,
+    fmi2String,
+    *const fmi2CallbackFunctions,
+    fmi2Boolean,
+    fmi2Boolean,
+) -> fmi2Component;
+pub type fmi2FreeInstanceTYPE = unsafe extern "C" fn(fmi2Component);
+pub type fmi2SetupExperimentTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    fmi2Boolean,
+    fmi2Real,
+    fmi2Real,
+    fmi2Boolean,
+    fmi2Real,
+) -> fmi2Status;
+pub type fmi2EnterInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2ExitInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2TerminateTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2ResetTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2GetRealTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Real,
+) -> fmi2Status;
+pub type fmi2GetIntegerTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Integer,
+) -> fmi2Status;
+pub type fmi2GetBooleanTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Boolean,
+) -> fmi2Status;
+pub type fmi2SetRealTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+) -> fmi2Status;
+pub type fmi2SetIntegerTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Integer,
+) -> fmi2Status;
+pub type fmi2SetBooleanTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Boolean,
+) -> fmi2Status;
+pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status;
+pub type fmi2FreeFMUstateTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Integer,
+    *const fmi2Real,
+) -> fmi2Status;
+pub type fmi2DoStepTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
+
+extern "C" {
+    fn calloc(nobj: usize, size: usize) -> *mut c_void;
+    fn free(obj: *mut c_void);
+}
+
+/// `fmi2Status` as returned; a value outside the standard's range is kept as `Unknown`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Warning,
+    Discard,
+    Error,
+    Fatal,
+    Pending,
+    Unknown(c_int),
+}
+
+impl Status {
+    pub fn from_c(s: fmi2Status) -> Self {
+        match s {
+            0 => Status::Ok,
+            1 => Status::Warning,
+            2 => Status::Discard,
+            3 => Status::Error,
+            4 => Status::Fatal,
+            5 => Status::Pending,
+            other => Status::Unknown(other),
+        }
+    }
+
+    /// fmi2OK or fmi2Warning: the call did what was asked.
+    pub fn is_success(self) -> bool {
+        matches!(self, Status::Ok | Status::Warning)
+    }
+
+    /// The status a logger callback received (the same numbering).
+    fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "fmi2OK",
+            Status::Warning => "fmi2Warning",
+            Status::Discard => "fmi2Discard",
+            Status::Error => "fmi2Error",
+            Status::Fatal => "fmi2Fatal",
+            Status::Pending => "fmi2Pending",
+            Status::Unknown(_) => "unknown status",
+        }
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Status::Unknown(v) => write!(f, "unknown status {v}"),
+            s => f.write_str(s.name()),
+        }
+    }
+}
+
+/// One call of the FMU's logger.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogMessage {
+    pub status: Status,
+    pub category: String,
+    pub message: String,
+}
+
+/// Where the logger callback of one instance puts its messages.
+pub type LogSink = Mutex<Vec<LogMessage>>;
+
+/// The master's logger: appends to the instance's [`LogSink`] (the component environment).
+/// Must not unwind into C: every step that could panic is inside `catch_unwind`.
+unsafe extern "C" fn log_message(
+    env: fmi2ComponentEnvironment,
+    _instance_name: fmi2String,
+    status: fmi2Status,
+    category: fmi2String,
+    message: fmi2String,
+) {
+    let text = |p: fmi2String| {
+        if p.is_null() {
+            String::new()
+        } else {
+            // SAFETY: the FMU passes NUL-terminated strings valid for the call.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    if env.is_null() {
+        return;
+    }
+    // SAFETY: env is the `LogSink` of the instance, kept alive until after fmi2FreeInstance.
+    let sink = unsafe { &*(env as *const LogSink) };
+    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let entry = LogMessage {
+            status: Status::from_c(status),
+            category: text(category),
+            message: text(message),
+        };
+        if let Ok(mut v) = sink.lock() {
+            v.push(entry);
+        }
+    }));
+}
+
+unsafe extern "C" fn allocate_memory(nobj: usize, size: usize) -> *mut c_void {
+    // SAFETY: libc's calloc, any arguments allowed.
+    unsafe { calloc(nobj, size) }
+}
+
+unsafe extern "C" fn free_memory(obj: *mut c_void) {
+    // SAFETY: obj came from allocate_memory (or is NULL), as the standard requires.
+    unsafe { free(obj) }
+}
+
+/// A required or optional function that the library does not export.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error("cannot load {path}: {source}")]
+    Open {
+        path: String,
+        source: libloading::Error,
+    },
+    #[error("{path} does not export {symbol}")]
+    Missing { path: String, symbol: &'static str },
+}
+
+/// The fmi2 functions of one loaded library. Optional ones are `None` when not exported.
+pub struct Api {
+    instantiate: fmi2InstantiateTYPE,
+    free_instance: fmi2FreeInstanceTYPE,
+    setup_experiment: fmi2SetupExperimentTYPE,
+    enter_initialization_mode: fmi2EnterInitializationModeTYPE,
+    exit_initialization_mode: fmi2ExitInitializationModeTYPE,
+    terminate: fmi2TerminateTYPE,
+    reset: fmi2ResetTYPE,
+    get_real: fmi2GetRealTYPE,
+    get_integer: fmi2GetIntegerTYPE,
+    get_boolean: fmi2GetBooleanTYPE,
+    set_real: fmi2SetRealTYPE,
+    set_integer: fmi2SetIntegerTYPE,
+    set_boolean: fmi2SetBooleanTYPE,
+    do_step: fmi2DoStepTYPE,
+    get_fmu_state: Option<fmi2GetFMUstateTYPE>,
+    set_fmu_state: Option<fmi2SetFMUstateTYPE>,
+    free_fmu_state: Option<fmi2FreeFMUstateTYPE>,
+    set_real_input_derivatives: Option<fmi2SetRealInputDerivativesTYPE>,
+    // Last: the function pointers above are only valid while the library is loaded.
+    _library: libloading::Library,
+}
+
+impl Api {
+    /// Loads the shared library of an extracted FMU and resolves its fmi2 functions.
+    ///
+    /// Loading runs the library's initializers; an FMU's binary is trusted code of the master's
+    /// choosing, as in every FMI importer.
+    pub fn load(path: &Path) -> Result<Arc<Api>, LoadError> {
+        let shown = path.display().to_string();
+        // SAFETY: see above: loading an FMU's library is running its code.
+        let library =
+            unsafe { libloading::Library::new(path) }.map_err(|source| LoadError::Open {
+                path: shown.clone(),
+                source,
+            })?;
+        macro_rules! optional {
+            ($name:literal, $ty:ty) => {
+                // SAFETY: the symbol has the C type the FMI standard gives it.
+                unsafe { library.get::<$ty>(concat!($name, "\0").as_bytes()) }
+                    .ok()
+                    .map(|s| *s)
+            };
+        }
+        macro_rules! required {
+            ($name:literal, $ty:ty) => {
+                optional!($name, $ty).ok_or_else(|| LoadError::Missing {
+                    path: shown.clone(),
+                    symbol: $name,
+                })?
+            };
+        }
+        Ok(Arc::new(Api {
+            instantiate: required!("fmi2Instantiate", fmi2InstantiateTYPE),
+            free_instance: required!("fmi2FreeInstance", fmi2FreeInstanceTYPE),
+            setup_experiment: required!("fmi2SetupExperiment", fmi2SetupExperimentTYPE),
+            enter_initialization_mode: required!(
+                "fmi2EnterInitializationMode",
+                fmi2EnterInitializationModeTYPE
+            ),
+            exit_initialization_mode: required!(
+                "fmi2ExitInitializationMode",
+                fmi2ExitInitializationModeTYPE
+            ),
+            terminate: required!("fmi2Terminate", fmi2TerminateTYPE),
+            reset: required!("fmi2Reset", fmi2ResetTYPE),
+            get_real: required!("fmi2GetReal", fmi2GetRealTYPE),
+            get_integer: required!("fmi2GetInteger", fmi2GetIntegerTYPE),
+            get_boolean: required!("fmi2GetBoolean", fmi2GetBooleanTYPE),
+            set_real: required!("fmi2SetReal", fmi2SetRealTYPE),
+            set_integer: required!("fmi2SetInteger", fmi2SetIntegerTYPE),
+            set_boolean: required!("fmi2SetBoolean", fmi2SetBooleanTYPE),
+            do_step: required!("fmi2DoStep", fmi2DoStepTYPE),
+            get_fmu_state: optional!("fmi2GetFMUstate", fmi2GetFMUstateTYPE),
+            set_fmu_state: optional!("fmi2SetFMUstate", fmi2SetFMUstateTYPE),
+            free_fmu_state: optional!("fmi2FreeFMUstate", fmi2FreeFMUstateTYPE),
+            set_real_input_derivatives: optional!(
+                "fmi2SetRealInputDerivatives",
+                fmi2SetRealInputDerivativesTYPE
+            ),
+            _library: library,
+        }))
+    }
+}
+
+/// An FMU state made by [`Instance::get_fmu_state`]; tagged with its instance so that it is never
+/// handed to another one.
+#[derive(Debug)]
+pub struct FmuState {
+    pointer: fmi2FMUstate,
+    owner: fmi2Component,
+}
+
+impl FmuState {
+    /// No state yet: `fmi2GetFMUstate` allocates a new one.
+    pub fn empty() -> Self {
+        FmuState {
+            pointer: std::ptr::null_mut(),
+            owner: std::ptr::null_mut(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pointer.is_null()
+    }
+}
+
+/// A function the library does not export, or a state of another instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refusal {
+    NotExported(&'static str),
+    ForeignState,
+}
+
+/// One co-simulation instance: the component and what C holds pointers to.
+pub struct Instance {
+    component: fmi2Component,
+    // Boxed: C keeps their addresses until fmi2FreeInstance.
+    _callbacks: Box<fmi2CallbackFunctions>,
+    log: Box<LogSink>,
+    api: Arc<Api>,
+}
+
+impl Instance {
+    /// `fmi2Instantiate(name, fmi2CoSimulation, guid, resources, callbacks, visible, loggingOn)`;
+    /// `Err` with what the logger got when it returns NULL.
+    pub fn instantiate(
+        api: &Arc<Api>,
+        name: &CStr,
+        guid: &CStr,
+        resource_location: &CStr,
+        visible: bool,
+        logging_on: bool,
+    ) -> Result<Instance, Vec<LogMessage>> {
+        let log: Box<LogSink> = Box::new(Mutex::new(Vec::new()));
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: Some(log_message),
+            allocateMemory: Some(allocate_memory),
+            freeMemory: Some(free_memory),
+            stepFinished: None,
+            componentEnvironment: &*log as *const LogSink as *mut c_void,
+        });
+        // SAFETY: valid C strings; callbacks and log boxed and kept with the instance.
+        let component = unsafe {
+            (api.instantiate)(
+                name.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                resource_location.as_ptr(),
+                &*callbacks,
+                visible as fmi2Boolean,
+                logging_on as fmi2Boolean,
+            )
+        };
+        if component.is_null() {
+            return Err(std::mem::take(
+                &mut *log.lock().unwrap_or_else(|e| e.into_inner()),
+            ));
+        }
+        Ok(Instance {
+            component,
+            _callbacks: callbacks,
+            log,
+            api: Arc::clone(api),
+        })
+    }
+
+    /// The messages logged since the last call of this function.
+    pub fn take_messages(&self) -> Vec<LogMessage> {
+        std::mem::take(&mut *self.log.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe {
+            (self.api.setup_experiment)(
+                self.component,
+                tolerance.is_some() as fmi2Boolean,
+                tolerance.unwrap_or(0.0),
+                start_time,
+                stop_time.is_some() as fmi2Boolean,
+                stop_time.unwrap_or(0.0),
+            )
+        })
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe { (self.api.enter_initialization_mode)(self.component) })
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe { (self.api.exit_initialization_mode)(self.component) })
+    }
+
+    pub fn terminate(&mut self) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe { (self.api.terminate)(self.component) })
+    }
+
+    pub fn reset(&mut self) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe { (self.api.reset)(self.component) })
+    }
+
+    pub fn do_step(&mut self, t: f64, h: f64, no_set_fmu_state_prior: bool) -> Status {
+        // SAFETY: a live component.
+        Status::from_c(unsafe {
+            (self.api.do_step)(self.component, t, h, no_set_fmu_state_prior as fmi2Boolean)
+        })
+    }
+
+    /// `fmi2GetReal`; panics if the slices differ in length (a bug of the caller).
+    pub fn get_real(&mut self, vr: &[fmi2ValueReference], values: &mut [f64]) -> Status {
+        assert_eq!(
+            vr.len(),
+            values.len(),
+            "fmi2GetReal: vr and values differ in length"
+        );
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.get_real)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
+        })
+    }
+
+    pub fn get_integer(&mut self, vr: &[fmi2ValueReference], values: &mut [i32]) -> Status {
+        assert_eq!(vr.len(), values.len(), "fmi2GetInteger: lengths differ");
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.get_integer)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
+        })
+    }
+
+    /// `fmi2GetBoolean`, values as the C `fmi2Boolean` (int).
+    pub fn get_boolean(&mut self, vr: &[fmi2ValueReference], values: &mut [i32]) -> Status {
+        assert_eq!(vr.len(), values.len(), "fmi2GetBoolean: lengths differ");
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.get_boolean)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
+        })
+    }
+
+    pub fn set_real(&mut self, vr: &[fmi2ValueReference], values: &[f64]) -> Status {
+        assert_eq!(vr.len(), values.len(), "fmi2SetReal: lengths differ");
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.set_real)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
+        })
+    }
+
+    pub fn set_integer(&mut self, vr: &[fmi2ValueReference], values: &[i32]) -> Status {
+        assert_eq!(vr.len(), values.len(), "fmi2SetInteger: lengths differ");
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.set_integer)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
+        })
+    }
+
+    /// `fmi2SetBoolean`, values as the C `fmi2Boolean` (int).
+    pub fn set_boolean(&mut self, vr: &[fmi2ValueReference], values: &[i32]) -> Status {
+        assert_eq!(vr.len(), values.len(), "fmi2SetBoolean: lengths differ");
+        // SAFETY: both arrays hold vr.len() elements.
+        Status::from_c(unsafe {
+            (self.api.set_boolean)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
+        })
+    }
+
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vr: &[fmi2ValueReference],
+        order: &[i32],
+        values: &[f64],
+    ) -> Result<Status, Refusal> {
+        assert!(
+            vr.len() == order.len() && vr.len() == values.len(),
+            "fmi2SetRealInputDerivatives: lengths differ"
+        );
+        let f = self
+            .api
+            .set_real_input_derivatives
+            .ok_or(Refusal::NotExported("fmi2SetRealInputDerivatives"))?;
+        // SAFETY: the three arrays hold vr.len() elements.
+        Ok(Status::from_c(unsafe {
+            f(
+                self.component,
+                vr.as_ptr(),
+                vr.len(),
+                order.as_ptr(),
+                values.as_ptr(),
+            )
+        }))
+    }
+
+    /// `fmi2GetFMUstate`: fills an empty `state` or overwrites one of this instance.
+    pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
+        let f = self
+            .api
+            .get_fmu_state
+            .ok_or(Refusal::NotExported("fmi2GetFMUstate"))?;
+        if !state.is_empty() && state.owner != self.component {
+            return Err(Refusal::ForeignState);
+        }
+        // SAFETY: state.pointer is NULL or a state of this component.
+        let s = Status::from_c(unsafe { f(self.component, &mut state.pointer) });
+        if !state.pointer.is_null() {
+            state.owner = self.component;
+        }
+        Ok(s)
+    }
+
+    pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, Refusal> {
+        let f = self
+            .api
+            .set_fmu_state
+            .ok_or(Refusal::NotExported("fmi2SetFMUstate"))?;
+        if state.is_empty() || state.owner != self.component {
+            return Err(Refusal::ForeignState);
+        }
+        // SAFETY: a state of this component.
+        Ok(Status::from_c(unsafe { f(self.component, state.pointer) }))
+    }
+
+    /// `fmi2FreeFMUstate`; the state is empty afterwards if the FMU set it to NULL.
+    pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
+        let f = self
+            .api
+            .free_fmu_state
+            .ok_or(Refusal::NotExported("fmi2FreeFMUstate"))?;
+        if state.is_empty() {
+            return Ok(Status::Ok);
+        }
+        if state.owner != self.component {
+            return Err(Refusal::ForeignState);
+        }
+        // SAFETY: a state of this component.
+        let s = Status::from_c(unsafe { f(self.component, &mut state.pointer) });
+        if state.pointer.is_null() {
+            state.owner = std::ptr::null_mut();
+        }
+        Ok(s)
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        // SAFETY: a live component, freed once; callbacks and log outlive the call.
+        unsafe { (self.api.free_instance)(self.component) }
+    }
+}

@@ -1,0 +1,553 @@
+//! A safe FMI 2.0 co-simulation slave over [`crate::fmi2_binding`]: extracts an `.fmu` into a
+//! directory of its own, reads its `modelDescription.xml`, loads the binary, and turns every
+//! status other than fmi2OK/fmi2Warning into a [`SlaveError`] that carries the function, the
+//! status and what the FMU logged.
+
+use crate::fmi2_binding::{self, Api, FmuState, Instance, LogMessage, Refusal, Status};
+use quick_xml::events::{BytesStart, Event};
+use std::ffi::CString;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use thiserror::Error;
+
+pub const PLATFORM: &str = "linux64";
+
+#[derive(Debug, Error)]
+pub enum SlaveError {
+    #[error("{}: {action}: {source}", .path.display())]
+    Io {
+        path: PathBuf,
+        action: &'static str,
+        source: std::io::Error,
+    },
+    #[error("{}: not a readable FMU archive: {source}", .path.display())]
+    Zip {
+        path: PathBuf,
+        source: zip::result::ZipError,
+    },
+    #[error("{}: modelDescription.xml: {message}", .path.display())]
+    ModelDescription { path: PathBuf, message: String },
+    #[error(transparent)]
+    Load(#[from] fmi2_binding::LoadError),
+    #[error("{function} returned {status}{}", messages_suffix(.messages))]
+    Call {
+        function: &'static str,
+        status: Status,
+        messages: Vec<LogMessage>,
+    },
+    #[error("fmi2Instantiate returned NULL{}", messages_suffix(.messages))]
+    Instantiate { messages: Vec<LogMessage> },
+    #[error("{function}: the FMU does not export it")]
+    NotExported { function: &'static str },
+    #[error("{function}: the FMU state belongs to another instance, or is empty")]
+    ForeignState { function: &'static str },
+    #[error("{function}: the instance was not instantiated (call Slave::instantiate)")]
+    NotInstantiated { function: &'static str },
+    #[error("no variable named `{name}` in the model description")]
+    UnknownVariable { name: String },
+    #[error("{what} contains a NUL byte")]
+    Nul { what: &'static str },
+}
+
+fn messages_suffix(messages: &[LogMessage]) -> String {
+    messages
+        .iter()
+        .map(|m| format!("\n  [{}] {}: {}", m.status, m.category, m.message))
+        .collect()
+}
+
+/// Base type of a scalar variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+    String,
+    Enumeration,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+    Local,
+    Independent,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub value_reference: u32,
+    pub var_type: VarType,
+    pub causality: Causality,
+}
+
+/// The `DefaultExperiment` element; each attribute optional.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DefaultExperiment {
+    pub start_time: Option<f64>,
+    pub stop_time: Option<f64>,
+    pub tolerance: Option<f64>,
+    pub step_size: Option<f64>,
+}
+
+/// What the master needs from `modelDescription.xml`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelDescription {
+    pub model_identifier: String,
+    pub guid: String,
+    pub can_get_and_set_fmu_state: bool,
+    pub can_interpolate_inputs: bool,
+    pub variables: Vec<Variable>,
+    pub default_experiment: DefaultExperiment,
+}
+
+impl ModelDescription {
+    /// Parses the XML text; `origin` names the file in errors.
+    pub fn parse(xml: &str, origin: &Path) -> Result<Self, SlaveError> {
+        let fail = |message: String| SlaveError::ModelDescription {
+            path: origin.to_path_buf(),
+            message,
+        };
+        let mut reader = quick_xml::Reader::from_str(xml);
+        let mut md = ModelDescription {
+            model_identifier: String::new(),
+            guid: String::new(),
+            can_get_and_set_fmu_state: false,
+            can_interpolate_inputs: false,
+            variables: Vec::new(),
+            default_experiment: DefaultExperiment::default(),
+        };
+        // The ScalarVariable being read: (name, vr, causality), until its type element.
+        let mut pending: Option<(String, u32, Causality)> = None;
+        let mut in_model_variables = false;
+        loop {
+            let event = reader
+                .read_event()
+                .map_err(|e| fail(format!("at byte {}: {e}", reader.buffer_position())))?;
+            let (e, empty) = match &event {
+                Event::Start(e) => (e, false),
+                Event::Empty(e) => (e, true),
+                Event::End(e) => {
+                    match e.name().as_ref() {
+                        b"ModelVariables" => in_model_variables = false,
+                        b"ScalarVariable" => {
+                            if let Some((name, ..)) = pending.take() {
+                                return Err(fail(format!("variable `{name}` has no type element")));
+                            }
+                        }
+                        _ => {}
+                    }
+                    continue;
+                }
+                Event::Eof => break,
+                _ => continue,
+            };
+            let attr = |key: &str| attribute(e, key).map_err(&fail);
+            match e.name().as_ref() {
+                b"fmiModelDescription" => {
+                    md.guid = attr("guid")?.ok_or_else(|| fail("no guid".into()))?;
+                }
+                b"CoSimulation" => {
+                    md.model_identifier = attr("modelIdentifier")?
+                        .ok_or_else(|| fail("CoSimulation has no modelIdentifier".into()))?;
+                    md.can_get_and_set_fmu_state =
+                        attr("canGetAndSetFMUstate")?.as_deref() == Some("true");
+                    md.can_interpolate_inputs =
+                        attr("canInterpolateInputs")?.as_deref() == Some("true");
+                }
+                b"DefaultExperiment" => {
+                    let num = |key: &str| -> Result<Option<f64>, SlaveError> {
+                        attr(key)?
+                            .map(|v| {
+                                v.trim().parse::<f64>().map_err(|_| {
+                                    fail(format!("DefaultExperiment {key}=\"{v}\" is not a number"))
+                                })
+                            })
+                            .transpose()
+                    };
+                    md.default_experiment = DefaultExperiment {
+                        start_time: num("startTime")?,
+                        stop_time: num("stopTime")?,
+                        tolerance: num("tolerance")?,
+                        step_size: num("stepSize")?,
+                    };
+                }
+                b"ModelVariables" => in_model_variables = !empty,
+                b"ScalarVariable" if in_model_variables => {
+                    let name =
+                        attr("name")?.ok_or_else(|| fail("a variable has no name".into()))?;
+                    let vr = attr("valueReference")?
+                        .and_then(|v| v.trim().parse::<u32>().ok())
+                        .ok_or_else(|| fail(format!("variable `{name}`: bad valueReference")))?;
+                    let causality = match attr("causality")?.as_deref().unwrap_or("local") {
+                        "parameter" => Causality::Parameter,
+                        "calculatedParameter" => Causality::CalculatedParameter,
+                        "input" => Causality::Input,
+                        "output" => Causality::Output,
+                        "local" => Causality::Local,
+                        "independent" => Causality::Independent,
+                        other => {
+                            return Err(fail(format!(
+                                "variable `{name}`: unknown causality `{other}`"
+                            )))
+                        }
+                    };
+                    if empty {
+                        return Err(fail(format!("variable `{name}` has no type element")));
+                    }
+                    pending = Some((name, vr, causality));
+                }
+                tag @ (b"Real" | b"Integer" | b"Boolean" | b"String" | b"Enumeration") => {
+                    if let Some((name, value_reference, causality)) = pending.take() {
+                        let var_type = match tag {
+                            b"Real" => VarType::Real,
+                            b"Integer" => VarType::Integer,
+                            b"Boolean" => VarType::Boolean,
+                            b"String" => VarType::String,
+                            _ => VarType::Enumeration,
+                        };
+                        md.variables.push(Variable {
+                            name,
+                            value_reference,
+                            var_type,
+                            causality,
+                        });
+                    }
+                }
+                _ => {}
+            }
+        }
+        if md.model_identifier.is_empty() {
+            return Err(fail(
+                "no CoSimulation element: not a co-simulation FMU".into(),
+            ));
+        }
+        Ok(md)
+    }
+
+    pub fn variable(&self, name: &str) -> Result<&Variable, SlaveError> {
+        self.variables
+            .iter()
+            .find(|v| v.name == name)
+            .ok_or_else(|| SlaveError::UnknownVariable { name: name.into() })
+    }
+
+    pub fn outputs(&self) -> impl Iterator<Item = &Variable> {
+        self.variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+    }
+}
+
+fn attribute(e: &BytesStart, key: &str) -> Result<Option<String>, String> {
+    match e.try_get_attribute(key) {
+        Ok(Some(a)) => a
+            .unescape_value()
+            .map(|v| Some(v.into_owned()))
+            .map_err(|err| format!("attribute {key}: {err}")),
+        Ok(None) => Ok(None),
+        Err(err) => Err(format!("attribute {key}: {err}")),
+    }
+}
+
+/// A fresh directory under the system temp dir, unique within and across processes.
+fn unique_directory(stem: &str) -> Result<PathBuf, SlaveError> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let base = std::env::temp_dir();
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.subsec_nanos())
+        .unwrap_or(0);
+    loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = base.join(format!(
+            "fmu-harness-{}-{n}-{nanos}-{stem}",
+            std::process::id()
+        ));
+        match std::fs::create_dir(&dir) {
+            Ok(()) => return Ok(dir),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(source) => {
+                return Err(SlaveError::Io {
+                    path: dir,
+                    action: "creating the extraction directory",
+                    source,
+                })
+            }
+        }
+    }
+}
+
+/// `file://` URI of a directory (absolute path, unreserved characters and `/` kept).
+fn file_uri(dir: &Path) -> String {
+    let mut uri = String::from("file://");
+    for b in dir.as_os_str().as_encoded_bytes() {
+        match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' | b'/' => {
+                uri.push(*b as char)
+            }
+            _ => uri.push_str(&format!("%{b:02X}")),
+        }
+    }
+    uri
+}
+
+/// One FMU: its extracted directory, model description, loaded binary and (after
+/// [`Slave::instantiate`]) one instance.
+pub struct Slave {
+    pub model_description: ModelDescription,
+    instance: Option<Instance>,
+    api: Arc<Api>,
+    dir: PathBuf,
+}
+
+impl Slave {
+    /// Extracts the FMU, reads its model description and loads `binaries/linux64/<id>.so`.
+    pub fn load(fmu: &Path) -> Result<Slave, SlaveError> {
+        let stem = fmu
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let stem: String = stem
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let dir = unique_directory(&stem)?;
+        match Self::load_into(fmu, &dir) {
+            Ok((model_description, api)) => Ok(Slave {
+                model_description,
+                instance: None,
+                api,
+                dir,
+            }),
+            Err(e) => {
+                let _ = std::fs::remove_dir_all(&dir);
+                Err(e)
+            }
+        }
+    }
+
+    fn load_into(fmu: &Path, dir: &Path) -> Result<(ModelDescription, Arc<Api>), SlaveError> {
+        let zip_err = |source| SlaveError::Zip {
+            path: fmu.to_path_buf(),
+            source,
+        };
+        let file = std::fs::File::open(fmu).map_err(|source| SlaveError::Io {
+            path: fmu.to_path_buf(),
+            action: "opening the FMU",
+            source,
+        })?;
+        let mut archive = zip::ZipArchive::new(file).map_err(zip_err)?;
+        archive.extract(dir).map_err(zip_err)?;
+        let md_path = dir.join("modelDescription.xml");
+        let xml = std::fs::read_to_string(&md_path).map_err(|source| SlaveError::Io {
+            path: fmu.join("modelDescription.xml"),
+            action: "reading",
+            source,
+        })?;
+        let md = ModelDescription::parse(&xml, &fmu.join("modelDescription.xml"))?;
+        let so = dir
+            .join("binaries")
+            .join(PLATFORM)
+            .join(format!("{}.so", md.model_identifier));
+        let api = Api::load(&so)?;
+        Ok((md, api))
+    }
+
+    /// The directory the FMU was extracted to (removed on drop).
+    pub fn directory(&self) -> &Path {
+        &self.dir
+    }
+
+    /// `fmi2Instantiate` as co-simulation, resources at the extracted `resources/`; replaces
+    /// (frees) a previous instance.
+    pub fn instantiate(&mut self, name: &str, logging_on: bool) -> Result<(), SlaveError> {
+        self.instance = None;
+        let name = CString::new(name).map_err(|_| SlaveError::Nul {
+            what: "the instance name",
+        })?;
+        let guid = CString::new(self.model_description.guid.as_str())
+            .map_err(|_| SlaveError::Nul { what: "the GUID" })?;
+        let uri =
+            CString::new(file_uri(&self.dir.join("resources"))).map_err(|_| SlaveError::Nul {
+                what: "the resource URI",
+            })?;
+        let instance = Instance::instantiate(&self.api, &name, &guid, &uri, false, logging_on)
+            .map_err(|messages| SlaveError::Instantiate { messages })?;
+        self.instance = Some(instance);
+        Ok(())
+    }
+
+    fn live(&mut self, function: &'static str) -> Result<&mut Instance, SlaveError> {
+        self.instance
+            .as_mut()
+            .ok_or(SlaveError::NotInstantiated { function })
+    }
+
+    /// Ok for fmi2OK and fmi2Warning; anything else an error with the logged messages.
+    fn check(&mut self, function: &'static str, status: Status) -> Result<Status, SlaveError> {
+        if status.is_success() {
+            Ok(status)
+        } else {
+            let messages = self.take_messages();
+            Err(SlaveError::Call {
+                function,
+                status,
+                messages,
+            })
+        }
+    }
+
+    fn refused(function: &'static str, r: Refusal) -> SlaveError {
+        match r {
+            Refusal::NotExported(_) => SlaveError::NotExported { function },
+            Refusal::ForeignState => SlaveError::ForeignState { function },
+        }
+    }
+
+    /// The messages the FMU logged since the last take (errors take them too).
+    pub fn take_messages(&mut self) -> Vec<LogMessage> {
+        self.instance
+            .as_ref()
+            .map(Instance::take_messages)
+            .unwrap_or_default()
+    }
+
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetupExperiment";
+        let s = self
+            .live(F)?
+            .setup_experiment(tolerance, start_time, stop_time);
+        self.check(F, s)
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2EnterInitializationMode";
+        let s = self.live(F)?.enter_initialization_mode();
+        self.check(F, s)
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2ExitInitializationMode";
+        let s = self.live(F)?.exit_initialization_mode();
+        self.check(F, s)
+    }
+
+    pub fn do_step(&mut self, t: f64, h: f64, no_set_prior: bool) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2DoStep";
+        let s = self.live(F)?.do_step(t, h, no_set_prior);
+        self.check(F, s)
+    }
+
+    pub fn terminate(&mut self) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2Terminate";
+        let s = self.live(F)?.terminate();
+        self.check(F, s)
+    }
+
+    pub fn reset(&mut self) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2Reset";
+        let s = self.live(F)?.reset();
+        self.check(F, s)
+    }
+
+    pub fn get_real(&mut self, vr: &[u32]) -> Result<Vec<f64>, SlaveError> {
+        const F: &str = "fmi2GetReal";
+        let mut values = vec![0.0; vr.len()];
+        let s = self.live(F)?.get_real(vr, &mut values);
+        self.check(F, s).map(|_| values)
+    }
+
+    pub fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetReal";
+        let s = self.live(F)?.set_real(vr, values);
+        self.check(F, s)
+    }
+
+    pub fn get_integer(&mut self, vr: &[u32]) -> Result<Vec<i32>, SlaveError> {
+        const F: &str = "fmi2GetInteger";
+        let mut values = vec![0; vr.len()];
+        let s = self.live(F)?.get_integer(vr, &mut values);
+        self.check(F, s).map(|_| values)
+    }
+
+    pub fn set_integer(&mut self, vr: &[u32], values: &[i32]) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetInteger";
+        let s = self.live(F)?.set_integer(vr, values);
+        self.check(F, s)
+    }
+
+    pub fn get_boolean(&mut self, vr: &[u32]) -> Result<Vec<bool>, SlaveError> {
+        const F: &str = "fmi2GetBoolean";
+        let mut values = vec![0; vr.len()];
+        let s = self.live(F)?.get_boolean(vr, &mut values);
+        self.check(F, s)
+            .map(|_| values.iter().map(|&b| b != 0).collect())
+    }
+
+    pub fn set_boolean(&mut self, vr: &[u32], values: &[bool]) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetBoolean";
+        let ints: Vec<i32> = values.iter().map(|&b| b as i32).collect();
+        let s = self.live(F)?.set_boolean(vr, &ints);
+        self.check(F, s)
+    }
+
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vr: &[u32],
+        order: &[i32],
+        values: &[f64],
+    ) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetRealInputDerivatives";
+        let s = self
+            .live(F)?
+            .set_real_input_derivatives(vr, order, values)
+            .map_err(|r| Self::refused(F, r))?;
+        self.check(F, s)
+    }
+
+    /// `fmi2GetFMUstate` into an empty state or one this instance made before.
+    pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2GetFMUstate";
+        let s = self
+            .live(F)?
+            .get_fmu_state(state)
+            .map_err(|r| Self::refused(F, r))?;
+        self.check(F, s)
+    }
+
+    pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2SetFMUstate";
+        let s = self
+            .live(F)?
+            .set_fmu_state(state)
+            .map_err(|r| Self::refused(F, r))?;
+        self.check(F, s)
+    }
+
+    pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, SlaveError> {
+        const F: &str = "fmi2FreeFMUstate";
+        let s = self
+            .live(F)?
+            .free_fmu_state(state)
+            .map_err(|r| Self::refused(F, r))?;
+        self.check(F, s)
+    }
+}
+
+impl Drop for Slave {
+    fn drop(&mut self) {
+        // fmi2FreeInstance first, while the library is loaded; the files go last.
+        self.instance = None;
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
