@@ -33,52 +33,42 @@ type = "weld"
 frames = ["world", "beam.a"]
 "#;
 
-/// A transverse tip force on a damped cantilever settles at F L³ / (3 E J), which Hermite
-/// elements reproduce exactly at the nodes; the tip rotation at F L² / (2 E J).
+/// Tip deflection and rotation of the damped cantilever settled under `load`.
+fn settled_tip(load: &str) -> (f64, f64) {
+    let outs = ["beam.tip.deflection", "beam.tip.phi"];
+    let r = run(cantilever(load, CLAMP), &[], &outs, 0.05, 3.0);
+    (r.last(1), r.last(2))
+}
+
+/// Small-deflection FE of the linear element: exact at the nodes, up to the axial shortening
+/// the floating frame neglects and the remaining decay of the damped vibration.
+fn assert_close(what: &str, got: f64, want: f64) {
+    println!("{what}: {got:.6e} (closed form {want:.6e})");
+    assert!((got - want).abs() < 1e-4 * want.abs(), "{what}");
+}
+
+/// A transverse tip force F: deflection F L³ / (3 E J), rotation F L² / (2 E J).
 #[test]
 fn tip_force_settles_at_the_static_deflection() {
     let f = 50.0;
-    let load = format!("[[load]]\nname = \"push\"\nframe = \"beam.b\"\nforce = [0.0, {f}]\n");
-    let r = run(
-        cantilever(&load, CLAMP),
-        &[],
-        &["beam.tip.deflection", "beam.tip.phi"],
-        0.05,
-        3.0,
-    );
+    let (d, phi) = settled_tip(&format!(
+        "[[load]]\nname = \"push\"\nframe = \"beam.b\"\nforce = [0.0, {f}]\n"
+    ));
     let ej = 210e9 * 0.01 * 0.02f64.powi(3) / 12.0;
-    let (d, phi) = (r.last(1), r.last(2));
-    let (d0, phi0) = (f / (3.0 * ej), f / (2.0 * ej));
-    println!(
-        "tip deflection {d:.6e} m (F L^3/3EJ = {d0:.6e}), rotation {phi:.6e} rad ({phi0:.6e})"
-    );
-    // small-deflection FE of the linear element: exact up to the axial shortening the
-    // floating frame neglects, and to the remaining decay of the damped vibration
-    assert!((d - d0).abs() < 1e-4 * d0);
-    assert!((phi - phi0).abs() < 1e-4 * phi0);
+    assert_close("tip deflection under F (m)", d, f / (3.0 * ej));
+    assert_close("tip rotation under F (rad)", phi, f / (2.0 * ej));
 }
 
-/// A torque at the tip: M L² / (2 E J) and M L / (E J).
+/// A tip torque M: deflection M L² / (2 E J), rotation M L / (E J).
 #[test]
 fn tip_torque_bends_the_beam() {
     let m = 20.0;
-    let load = format!("[[load]]\nname = \"twist\"\nframe = \"beam.b\"\ntorque = {m}\n");
-    let r = run(
-        cantilever(&load, CLAMP),
-        &[],
-        &["beam.tip.deflection", "beam.tip.phi"],
-        0.05,
-        3.0,
-    );
+    let (d, phi) = settled_tip(&format!(
+        "[[load]]\nname = \"twist\"\nframe = \"beam.b\"\ntorque = {m}\n"
+    ));
     let ej = 210e9 * 0.01 * 0.02f64.powi(3) / 12.0;
-    let (d, phi) = (r.last(1), r.last(2));
-    println!(
-        "tip deflection {d:.6e} m ({:.6e}), rotation {phi:.6e} rad ({:.6e})",
-        m / (2.0 * ej),
-        m / ej
-    );
-    assert!((d - m / (2.0 * ej)).abs() < 1e-4 * m / (2.0 * ej));
-    assert!((phi - m / ej).abs() < 1e-4 * m / ej);
+    assert_close("tip deflection under M (m)", d, m / (2.0 * ej));
+    assert_close("tip rotation under M (rad)", phi, m / ej);
 }
 
 /// Two welds on the same flange fix the same motion twice: refused, naming the joints.
