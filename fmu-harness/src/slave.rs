@@ -551,3 +551,54 @@ impl Drop for Slave {
         let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="m" guid="{g&amp;1}">
+  <CoSimulation modelIdentifier="m_id" canGetAndSetFMUstate="true"/>
+  <DefaultExperiment startTime="0.5" stopTime="2" stepSize="1e-3"/>
+  <ModelVariables>
+    <ScalarVariable name="k" valueReference="3" causality="parameter"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="n" valueReference="7"><Integer/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
+  </ModelVariables>
+</fmiModelDescription>"#;
+
+    #[test]
+    fn model_description_gives_identifier_guid_variables_and_experiment() {
+        let md = ModelDescription::parse(XML, Path::new("x.fmu")).unwrap();
+        assert_eq!(md.model_identifier, "m_id");
+        assert_eq!(md.guid, "{g&1}");
+        assert!(md.can_get_and_set_fmu_state && !md.can_interpolate_inputs);
+        assert_eq!(md.variables.len(), 3);
+        let n = md.variable("n").unwrap();
+        assert_eq!(
+            (n.value_reference, n.var_type, n.causality),
+            (7, VarType::Integer, Causality::Local)
+        );
+        assert_eq!(
+            md.outputs().map(|v| v.name.as_str()).collect::<Vec<_>>(),
+            ["y"]
+        );
+        let de = md.default_experiment;
+        assert_eq!(
+            (de.start_time, de.stop_time, de.step_size, de.tolerance),
+            (Some(0.5), Some(2.0), Some(1e-3), None)
+        );
+    }
+
+    #[test]
+    fn a_model_exchange_only_description_is_refused() {
+        let xml = XML.replace("CoSimulation", "ModelExchange");
+        let e = ModelDescription::parse(&xml, Path::new("x.fmu")).unwrap_err();
+        assert!(e.to_string().contains("no CoSimulation element"), "{e}");
+    }
+
+    #[test]
+    fn file_uri_escapes_reserved_bytes() {
+        assert_eq!(file_uri(Path::new("/tmp/a b%/r")), "file:///tmp/a%20b%25/r");
+    }
+}
