@@ -1,17 +1,17 @@
 //! Random FMI call sequences through the project's own master (issue 7): illegal orders,
 //! unknown value references, NaN and negative steps, wrong communication points, calls after
 //! terminate and after another instance of the same unit was freed. Every call returns a
-//! status or a refusal, nothing crashes, and a fresh instance afterwards runs bit for bit as
+//! status or a refusal with the FMU's message, nothing crashes, and a fresh instance afterwards runs bit for bit as
 //! one that never saw them. (Null pointers are sent straight to the exports in
 //! fmu-beam/src/fmi2/abi_tests.rs; arrays of mismatched length cannot be sent: the binding
 //! refuses to build such a call, and a C master that did would overrun its own arrays.)
 
 mod common;
 use common::*;
-use fmu_harness::fmi2_binding::FmuState;
-use fmu_harness::slave::Slave;
+use fmu_harness::fmi2_binding::{FmuState, Status};
+use fmu_harness::slave::{Slave, SlaveError};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use std::path::{Path, PathBuf};
 
 fn c1_fmu() -> PathBuf {
@@ -118,34 +118,52 @@ fn random_sequences_through_the_master_never_crash() {
                 b
             });
             let mut t = 0.0;
+            // a refusal must be an error status with the FMU's message
+            let mut check = |r: Result<Status, SlaveError>| -> Result<bool, TestCaseError> {
+                match r {
+                    Ok(_) => Ok(true),
+                    Err(SlaveError::Call {
+                        function,
+                        status,
+                        messages,
+                    }) => {
+                        prop_assert!(
+                            !messages.is_empty(),
+                            "{function} returned {status} without a message"
+                        );
+                        Ok(false)
+                    }
+                    Err(other) => Err(TestCaseError::fail(format!("unexpected: {other}"))),
+                }
+            };
             for c in &calls {
                 let ok = match c {
-                    Call::Setup(t0) => a.setup_experiment(None, *t0, None).is_ok(),
-                    Call::Enter => a.enter_initialization_mode().is_ok(),
-                    Call::Exit => a.exit_initialization_mode().is_ok(),
+                    Call::Setup(t0) => check(a.setup_experiment(None, *t0, None))?,
+                    Call::Enter => check(a.enter_initialization_mode())?,
+                    Call::Exit => check(a.exit_initialization_mode())?,
                     Call::DoStep(h, right) => {
                         let at = if *right { t } else { t + 0.5 };
-                        let ok = a.do_step(at, *h, false).is_ok();
+                        let ok = check(a.do_step(at, *h, false))?;
                         if ok {
                             t = at + h;
                         }
                         ok
                     }
-                    Call::GetReal(v) => a.get_real(&[*v]).is_ok(),
-                    Call::SetReal(v, x) => a.set_real(&[*v], &[*x]).is_ok(),
-                    Call::GetInteger(v) => a.get_integer(&[*v]).is_ok(),
-                    Call::SetBoolean(v, b) => a.set_boolean(&[*v], &[*b]).is_ok(),
+                    Call::GetReal(v) => check(a.get_real(&[*v]).map(|_| Status::Ok))?,
+                    Call::SetReal(v, x) => check(a.set_real(&[*v], &[*x]))?,
+                    Call::GetInteger(v) => check(a.get_integer(&[*v]).map(|_| Status::Ok))?,
+                    Call::SetBoolean(v, b) => check(a.set_boolean(&[*v], &[*b]))?,
                     Call::StateRoundTrip => {
                         let mut s = FmuState::empty();
-                        let ok = a.get_fmu_state(&mut s).is_ok() && a.set_fmu_state(&s).is_ok();
+                        let ok = check(a.get_fmu_state(&mut s))? && check(a.set_fmu_state(&s))?;
                         let _ = a.free_fmu_state(&mut s);
                         ok
                     }
                     Call::Reset => {
                         t = 0.0;
-                        a.reset().is_ok()
+                        check(a.reset())?
                     }
-                    Call::Terminate => a.terminate().is_ok(),
+                    Call::Terminate => check(a.terminate())?,
                     Call::FreeTheOther => {
                         other = None;
                         true
