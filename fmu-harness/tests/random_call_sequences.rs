@@ -119,7 +119,7 @@ fn random_sequences_through_the_master_never_crash() {
             });
             let mut t = 0.0;
             // a refusal must be an error status with the FMU's message
-            let mut check = |r: Result<Status, SlaveError>| -> Result<bool, TestCaseError> {
+            let check = |r: Result<Status, SlaveError>| -> Result<bool, TestCaseError> {
                 match r {
                     Ok(_) => Ok(true),
                     Err(SlaveError::Call {
