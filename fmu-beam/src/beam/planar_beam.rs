@@ -112,18 +112,25 @@ struct FullIntegrals {
 impl PlanarBeam {
     /// Builds the beam from its (validated) scene entry.
     pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
-        let section = Section::from_spec(&spec.section);
-        PlanarBeam::new(
-            &spec.name,
-            spec.length,
+        PlanarBeam::part_of(spec, &spec.name, spec.length)
+    }
+
+    /// One floating frame of a (validated) scene beam: the whole beam, or one of its
+    /// substructures, named `name`, of length `length`.
+    pub fn part_of(spec: &BeamSpec, name: &str, length: f64) -> PlanarBeam {
+        let mut b = PlanarBeam::new(
+            name,
+            length,
             crate::scene::Scene::beam_layout(spec).0,
             spec.frame,
             spec.material.rho,
             spec.material.e,
-            section,
+            Section::from_spec(&spec.section),
             spec.rayleigh.alpha,
             spec.rayleigh.beta,
-        )
+        );
+        b.set_geometric_stiffening(spec.geometric_stiffening);
+        b
     }
 
     pub fn new(

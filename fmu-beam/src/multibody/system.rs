@@ -118,7 +118,7 @@ impl System {
         let mut bodies = Vec::new();
         let mut beams = Vec::new();
         for spec in &scene.beams {
-            let (elements, k) = Scene::beam_layout(spec);
+            let (_, k) = Scene::beam_layout(spec);
             let first = bodies.len();
             let section = crate::beam::section::Section::from_spec(&spec.section);
             if spec.rigid {
@@ -141,18 +141,7 @@ impl System {
                     } else {
                         format!("{}[{i}]", spec.name)
                     };
-                    let mut b = PlanarBeam::new(
-                        &name,
-                        ls,
-                        elements,
-                        spec.frame,
-                        spec.material.rho,
-                        spec.material.e,
-                        section,
-                        spec.rayleigh.alpha,
-                        spec.rayleigh.beta,
-                    );
-                    b.set_geometric_stiffening(spec.geometric_stiffening);
+                    let b = PlanarBeam::part_of(spec, &name, ls);
                     bodies.push(Body::Beam(Box::new(b)));
                 }
             }
