@@ -1,5 +1,5 @@
 """Work-precision chart of `fmu-harness work-precision` (run by `make bench`): relative error
-of each case's main output against time, log-log, one curve per integrator mode.
+of each case's main output against CPU time, log-log, one curve per integrator mode.
 Reads build/bench/work_precision.csv, writes build/bench/work_precision.png."""
 import csv
 import sys
@@ -19,7 +19,7 @@ curves = defaultdict(list)
 with open(src) as f:
     for row in csv.DictReader(f):
         curves[(row["case"], row["mode"])].append(
-            (float(row["seconds_median"]), float(row["error_relative"]), float(row["setting"])))
+            (float(row["cpu_seconds_median"]), float(row["error_relative"]), float(row["setting"])))
 
 cases = sorted({c for c, _ in curves})
 fig, ax = plt.subplots(figsize=(8, 5.5))
@@ -30,7 +30,7 @@ for i, case in enumerate(cases):
         if pts:
             ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, color=colors[i % len(colors)],
                       label=f"{case}, {'error control' if mode == 'adaptive' else 'fixed step'}", ms=4)
-ax.set_xlabel("time of one run (s, median of 3, one thread)")
+ax.set_xlabel("CPU time of one run (s, median of 3, one thread)")
 ax.set_ylabel("max |error| / max |reference| of the main output")
 ax.set_title("Work-precision: error against a tolerance-1e-9 reference vs. time")
 ax.grid(True, which="both", alpha=0.3)
