@@ -228,15 +228,15 @@ impl Engine {
             }
             return Ok(());
         }
-        let target = match (var.causality, var.binding) {
-            (Causality::Parameter, Binding::Parameter(t)) => t,
-            _ => {
-                return Err(EngineError::NotSettable {
-                    name,
-                    reason: format!("it is a {} variable", var.causality.as_str()),
-                })
-            }
-        };
+        if !matches!(
+            (var.causality, var.binding),
+            (Causality::Parameter, Binding::Parameter(_))
+        ) {
+            return Err(EngineError::NotSettable {
+                name,
+                reason: format!("it is a {} variable", var.causality.as_str()),
+            });
+        }
         if self.initialized && var.variability == Variability::Fixed {
             return Err(EngineError::NotSettable {
                 name,
@@ -259,7 +259,6 @@ impl Engine {
             Some(m) if self.initialized => m.stepper.settings = Settings::from_scene(&scene),
             _ => self.model = None,
         }
-        let _ = target;
         Ok(())
     }
 
