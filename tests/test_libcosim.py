@@ -7,10 +7,10 @@ Both masters make the same calls (setup, initialization, doStep from t to t + h)
 deterministic. "The same steps" must mean the same doubles: libcosim counts time in integer
 nanoseconds, and fmpy's usual t = k h differs from its t by an ulp now and then. With error control
 (the scene's default) such an ulp can flip one accept/reject decision of the step-size controller,
-after which the runs differ at the level of the tolerance (C2, 1e-3 s steps: 4e-4 of the peak tip
-deflection after 11 steps). So fmpy is driven here at libcosim's communication points. A run of
-fmpy at a different communication step disagrees by far more than the bound: the comparison can
-tell."""
+after which the runs differ at the level of the tolerance (C2, 1e-3 s steps: from step 12 on, up
+to 4e-4 of the peak tip deflection over 0.5 s). So fmpy is driven here at libcosim's communication
+points. A run of fmpy at a different communication step disagrees by far more than the bound: the
+comparison can tell."""
 
 import numpy as np
 import pytest
