@@ -1,7 +1,7 @@
-//! The command line: `package`, `modes`, `work-precision` and `simulate`.
+//! The command line: `package`, `modes`, `work-precision`, `simulate` and `cosim`.
 
 use crate::error::HarnessError;
-use crate::{modes, package, simulate, work_precision};
+use crate::{cosim, modes, package, simulate, work_precision};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -54,6 +54,16 @@ pub enum Command {
         #[arg(long, value_delimiter = ',')]
         output: Vec<String>,
         /// The CSV file to write [default: standard output].
+        #[arg(short = 'o', long = "csv")]
+        csv: Option<PathBuf>,
+    },
+    /// Couple several FMI 2.0 co-simulation FMUs as a system file says (units, connections,
+    /// fixed or variable communication step, Jacobi or Gauss-Seidel, input extrapolation,
+    /// rollback); write the chosen outputs as CSV and print a summary.
+    Cosim {
+        /// The system file (TOML); FMU paths in it are relative to it.
+        system: PathBuf,
+        /// The CSV file to write [default: standard output, summary on standard error].
         #[arg(short = 'o', long = "csv")]
         csv: Option<PathBuf>,
     },
@@ -153,6 +163,22 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 Some(path) => std::fs::write(&path, text)
                     .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?,
                 None => out.write_all(text.as_bytes()).map_err(stdout_err)?,
+            }
+        }
+        Command::Cosim { system, csv } => {
+            let (results, summary) = cosim::cosim(&system)?;
+            match csv {
+                Some(path) => {
+                    std::fs::write(&path, results.csv())
+                        .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?;
+                    write!(out, "{}wrote {}\n", summary.text(), path.display())
+                        .map_err(stdout_err)?;
+                }
+                None => {
+                    out.write_all(results.csv().as_bytes())
+                        .map_err(stdout_err)?;
+                    eprint!("{}", summary.text());
+                }
             }
         }
         Command::Modes { scene, count } => {

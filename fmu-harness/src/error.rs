@@ -44,6 +44,8 @@ pub enum HarnessError {
     CanonicalScene { scene: String, message: String },
     #[error(transparent)]
     Simulate(#[from] crate::simulate::SimulateError),
+    #[error(transparent)]
+    Cosim(#[from] crate::cosim::CosimError),
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
     BadOutput { path: PathBuf },
 }

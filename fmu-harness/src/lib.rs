@@ -8,6 +8,7 @@
 
 pub mod archive;
 pub mod cli;
+pub mod cosim;
 pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi2_binding;

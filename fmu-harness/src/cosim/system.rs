@@ -1,0 +1,471 @@
+//! The system file of `fmu-harness cosim` (TOML, serde with `deny_unknown_fields`): units,
+//! connections, experiment, communication step, coupling algorithm, input extrapolation,
+//! rollback. [`System::load`] parses and checks it; every error names the file and the field.
+
+use serde::de::{self, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum SystemError {
+    #[error("{}: {message}", .path.display())]
+    Read { path: PathBuf, message: String },
+    #[error("{}: {message}", .path.display())]
+    Parse { path: PathBuf, message: String },
+    #[error("{}: field `{field}`: {message}", .path.display())]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+}
+
+/// The whole system file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct System {
+    #[serde(default)]
+    pub start_time: f64,
+    pub stop_time: f64,
+    pub step: StepSpec,
+    #[serde(default)]
+    pub algorithm: Algorithm,
+    /// Gauss–Seidel order of the units (names); default: the order of `[[unit]]`.
+    #[serde(default)]
+    pub order: Vec<String>,
+    #[serde(default)]
+    pub extrapolation: Extrapolation,
+    #[serde(default)]
+    pub rollback: Option<RollbackSpec>,
+    /// Columns of the CSV, `<unit>.<variable>`; empty = every output of every unit.
+    #[serde(default)]
+    pub outputs: Vec<String>,
+    #[serde(rename = "unit")]
+    pub units: Vec<UnitSpec>,
+    #[serde(default)]
+    pub connections: Vec<ConnectionSpec>,
+}
+
+/// Communication step: `size` fixed, or (with `variable`) the first step of the step-size
+/// control on the extrapolation error of the coupling signals.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepSpec {
+    pub size: f64,
+    #[serde(default)]
+    pub variable: Option<VariableStep>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariableStep {
+    pub min: f64,
+    pub max: f64,
+    /// Per signal: |y(t+h) − extrapolated y(t+h)| ≤ abs_tolerance + tolerance·|y(t+h)|.
+    pub tolerance: f64,
+    #[serde(default)]
+    pub abs_tolerance: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Algorithm {
+    /// Every unit steps from the values at t (order irrelevant).
+    #[default]
+    Jacobi,
+    /// Units step in `order`; a unit gets the t + h outputs of the units before it.
+    GaussSeidel,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Extrapolation {
+    /// Inputs held constant over a step.
+    #[default]
+    None,
+    /// Polynomial of order 1 through the last two communication points (order 2: three), handed
+    /// over with fmi2SetRealInputDerivatives to units whose canInterpolateInputs is true.
+    Linear,
+    Quadratic,
+}
+
+impl Extrapolation {
+    pub fn order(self) -> usize {
+        match self {
+            Extrapolation::None => 0,
+            Extrapolation::Linear => 1,
+            Extrapolation::Quadratic => 2,
+        }
+    }
+}
+
+/// Retry a step with half the step from the FMU states saved at its start.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollbackSpec {
+    /// Halvings of one step before the run is given up.
+    #[serde(default = "default_max_halvings")]
+    pub max_halvings: u32,
+    /// Retry when a unit returns fmi2Discard from fmi2DoStep.
+    #[serde(default = "default_true")]
+    pub on_discard: bool,
+    #[serde(default, rename = "check")]
+    pub checks: Vec<CheckSpec>,
+}
+
+fn default_max_halvings() -> u32 {
+    10
+}
+fn default_true() -> bool {
+    true
+}
+
+/// An output that must stay within bounds at the end of every step, else the step is retried.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckSpec {
+    /// `<unit>.<variable>`.
+    pub variable: String,
+    #[serde(default)]
+    pub min: Option<f64>,
+    #[serde(default)]
+    pub max: Option<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitSpec {
+    /// Unit name, no `.` in it: `<unit>.<variable>` names its variables.
+    pub name: String,
+    /// The FMU, relative to the system file.
+    pub fmu: PathBuf,
+    /// Start values of parameters (or inputs), set before initialization.
+    #[serde(default)]
+    pub start: BTreeMap<String, StartValue>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum StartValue {
+    Boolean(bool),
+    Integer(i64),
+    Real(f64),
+}
+
+/// `"a.x -> b.u"`, or `{ from = "a.x", to = "b.u", factor = -1.0 }` (u = factor·x).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnectionSpec {
+    pub from: String,
+    pub to: String,
+    pub factor: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConnectionTable {
+    from: String,
+    to: String,
+    #[serde(default = "one")]
+    factor: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl<'de> Deserialize<'de> for ConnectionSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ConnectionSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(r#""<unit>.<output> -> <unit>.<input>" or { from, to, factor }"#)
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<ConnectionSpec, E> {
+                let (from, to) = s.split_once("->").ok_or_else(|| {
+                    E::custom(format!(
+                        "connection `{s}`: expected \"<unit>.<output> -> <unit>.<input>\""
+                    ))
+                })?;
+                Ok(ConnectionSpec {
+                    from: from.trim().to_string(),
+                    to: to.trim().to_string(),
+                    factor: 1.0,
+                })
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ConnectionSpec, A::Error> {
+                let t = ConnectionTable::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                Ok(ConnectionSpec {
+                    from: t.from,
+                    to: t.to,
+                    factor: t.factor,
+                })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Splits `<unit>.<variable>` at the first dot.
+pub fn split_name(full: &str) -> Option<(&str, &str)> {
+    full.split_once('.')
+        .filter(|(u, v)| !u.is_empty() && !v.is_empty())
+}
+
+impl System {
+    /// Reads, parses and checks a system file.
+    pub fn load(path: &Path) -> Result<System, SystemError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SystemError::Read {
+            path: path.to_path_buf(),
+            message: format!("reading the system file: {e}"),
+        })?;
+        System::from_toml_str(&text, path)
+    }
+
+    /// Parses and checks system text; `path` names the file in errors.
+    pub fn from_toml_str(text: &str, path: &Path) -> Result<System, SystemError> {
+        let system: System = toml::from_str(text).map_err(|e| SystemError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        system.check(path)?;
+        Ok(system)
+    }
+
+    /// Value rules that serde cannot express.
+    fn check(&self, path: &Path) -> Result<(), SystemError> {
+        let bad = |field: &str, message: String| SystemError::Invalid {
+            path: path.to_path_buf(),
+            field: field.to_string(),
+            message,
+        };
+        if !(self.start_time.is_finite() && self.stop_time.is_finite())
+            || self.stop_time <= self.start_time
+        {
+            return Err(bad(
+                "stop_time",
+                format!(
+                    "= {}: must be finite and after start_time = {}",
+                    self.stop_time, self.start_time
+                ),
+            ));
+        }
+        let positive = |field: &str, v: f64| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(field, format!("= {v}: must be positive and finite")))
+            }
+        };
+        positive("step.size", self.step.size)?;
+        if let Some(v) = &self.step.variable {
+            positive("step.variable.min", v.min)?;
+            positive("step.variable.max", v.max)?;
+            positive("step.variable.tolerance", v.tolerance)?;
+            if !(v.abs_tolerance >= 0.0 && v.abs_tolerance.is_finite()) {
+                return Err(bad(
+                    "step.variable.abs_tolerance",
+                    format!("= {}: must be non-negative", v.abs_tolerance),
+                ));
+            }
+            if !(v.min <= self.step.size && self.step.size <= v.max) {
+                return Err(bad(
+                    "step.size",
+                    format!(
+                        "= {}: the first step must lie in [step.variable.min, step.variable.max] = [{}, {}]",
+                        self.step.size, v.min, v.max
+                    ),
+                ));
+            }
+        }
+        if self.units.is_empty() {
+            return Err(bad("unit", "at least one [[unit]] is needed".into()));
+        }
+        for (i, u) in self.units.iter().enumerate() {
+            if u.name.is_empty() || u.name.contains('.') {
+                return Err(bad(
+                    &format!("unit[{i}].name"),
+                    format!("= \"{}\": must be non-empty and without `.`", u.name),
+                ));
+            }
+            if self.units[..i].iter().any(|o| o.name == u.name) {
+                return Err(bad(
+                    &format!("unit[{i}].name"),
+                    format!("= \"{}\": two units have this name", u.name),
+                ));
+            }
+        }
+        let unit_of = |field: &str, full: &str| -> Result<(), SystemError> {
+            let (u, _) = split_name(full)
+                .ok_or_else(|| bad(field, format!("= \"{full}\": expected <unit>.<variable>")))?;
+            if self.units.iter().any(|x| x.name == u) {
+                Ok(())
+            } else {
+                Err(bad(
+                    field,
+                    format!(
+                        "= \"{full}\": no unit named `{u}` (units: {})",
+                        self.unit_names()
+                    ),
+                ))
+            }
+        };
+        for (i, c) in self.connections.iter().enumerate() {
+            unit_of(&format!("connections[{i}].from"), &c.from)?;
+            unit_of(&format!("connections[{i}].to"), &c.to)?;
+            if !c.factor.is_finite() {
+                return Err(bad(
+                    &format!("connections[{i}].factor"),
+                    format!("= {}: must be finite", c.factor),
+                ));
+            }
+            if let Some(j) = self.connections[..i].iter().position(|o| o.to == c.to) {
+                return Err(bad(
+                    &format!("connections[{i}].to"),
+                    format!("= \"{}\": already set by connections[{j}]", c.to),
+                ));
+            }
+        }
+        for (i, o) in self.outputs.iter().enumerate() {
+            unit_of(&format!("outputs[{i}]"), o)?;
+        }
+        if !self.order.is_empty() {
+            let mut sorted: Vec<&str> = self.order.iter().map(String::as_str).collect();
+            sorted.sort_unstable();
+            let mut names: Vec<&str> = self.units.iter().map(|u| u.name.as_str()).collect();
+            names.sort_unstable();
+            if sorted != names {
+                return Err(bad(
+                    "order",
+                    format!(
+                        "= {:?}: must name every unit exactly once (units: {})",
+                        self.order,
+                        self.unit_names()
+                    ),
+                ));
+            }
+        }
+        if let Some(r) = &self.rollback {
+            for (i, c) in r.checks.iter().enumerate() {
+                let field = format!("rollback.check[{i}]");
+                unit_of(&format!("{field}.variable"), &c.variable)?;
+                if c.min.is_none() && c.max.is_none() {
+                    return Err(bad(&field, "needs `min`, `max` or both".into()));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn unit_names(&self) -> String {
+        self.units
+            .iter()
+            .map(|u| u.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Unit indices in stepping order.
+    pub fn stepping_order(&self) -> Vec<usize> {
+        if self.order.is_empty() {
+            (0..self.units.len()).collect()
+        } else {
+            self.order
+                .iter()
+                .map(|n| self.units.iter().position(|u| &u.name == n).unwrap_or(0))
+                .collect()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OK: &str = r#"
+stop_time = 1.0
+step = { size = 1e-2 }
+algorithm = "gauss-seidel"
+order = ["b", "a"]
+extrapolation = "linear"
+connections = ["a.x -> b.u", { from = "b.y", to = "a.u", factor = -1.0 }]
+[[unit]]
+name = "a"
+fmu = "a.fmu"
+start = { k = 2.0, n = 3, on = true }
+[[unit]]
+name = "b"
+fmu = "b.fmu"
+[rollback]
+max_halvings = 4
+check = [{ variable = "a.e", max = 1.0 }]
+"#;
+
+    fn parse(text: &str) -> Result<System, SystemError> {
+        System::from_toml_str(text, Path::new("sys.toml"))
+    }
+
+    #[test]
+    fn a_full_system_file_is_read() {
+        let s = parse(OK).unwrap();
+        assert_eq!(s.algorithm, Algorithm::GaussSeidel);
+        assert_eq!(s.stepping_order(), [1, 0]);
+        assert_eq!(s.extrapolation, Extrapolation::Linear);
+        assert_eq!(s.connections[0].factor, 1.0);
+        assert_eq!(
+            (s.connections[1].from.as_str(), s.connections[1].factor),
+            ("b.y", -1.0)
+        );
+        assert_eq!(s.units[0].start["k"], StartValue::Real(2.0));
+        assert_eq!(s.units[0].start["n"], StartValue::Integer(3));
+        assert_eq!(s.rollback.as_ref().unwrap().max_halvings, 4);
+        assert!(s.rollback.as_ref().unwrap().on_discard);
+    }
+
+    #[test]
+    fn errors_name_the_file_and_the_field() {
+        let cases = [
+            (
+                OK.replace("max_halvings", "max_halving"),
+                "unknown field `max_halving`",
+            ),
+            (
+                OK.replace("a.x -> b.u", "a.x => b.u"),
+                "expected \"<unit>.<output> -> <unit>.<input>\"",
+            ),
+            (
+                OK.replace("a.x -> b.u", "c.x -> b.u"),
+                "field `connections[0].from`: = \"c.x\": no unit named `c`",
+            ),
+            (
+                OK.replace("\"b.y\"", "\"b.y\", gain = 2"),
+                "unknown field `gain`",
+            ),
+            (OK.replace("[\"b\", \"a\"]", "[\"b\"]"), "field `order`"),
+            (
+                OK.replace("size = 1e-2", "size = -1"),
+                "field `step.size`: = -1: must be positive",
+            ),
+            (
+                OK.replace("max = 1.0", "bound = 1.0"),
+                "unknown field `bound`",
+            ),
+            (
+                OK.replace("\"gauss-seidel\"", "\"newton\""),
+                "unknown variant `newton`",
+            ),
+            (
+                OK.replace("name = \"b\"", "name = \"a\""),
+                "field `unit[1].name`",
+            ),
+        ];
+        for (text, expected) in cases {
+            let e = parse(&text).unwrap_err().to_string();
+            assert!(e.starts_with("sys.toml: "), "{e}");
+            assert!(e.contains(expected), "expected `{expected}` in: {e}");
+        }
+    }
+}
