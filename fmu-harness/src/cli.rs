@@ -171,7 +171,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 Some(path) => {
                     std::fs::write(&path, results.csv())
                         .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?;
-                    write!(out, "{}wrote {}\n", summary.text(), path.display())
+                    writeln!(out, "{}wrote {}", summary.text(), path.display())
                         .map_err(stdout_err)?;
                 }
                 None => {

@@ -612,8 +612,8 @@ fn attempt(
         let u = &mut units[c.unit];
         let value = u.slave.get_real(&[c.vr]).map_err(|e| u.fail(e))?[0];
         let bound = match (c.min, c.max) {
-            (Some(lo), _) if !(value >= lo) => Some(format!("min = {lo:e}")),
-            (_, Some(hi)) if !(value <= hi) => Some(format!("max = {hi:e}")),
+            (Some(lo), _) if value.is_nan() || value < lo => Some(format!("min = {lo:e}")),
+            (_, Some(hi)) if value.is_nan() || value > hi => Some(format!("max = {hi:e}")),
             _ => None,
         };
         if let Some(bound) = bound {
