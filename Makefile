@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools release fmus demo test check bench clean distclean
+.PHONY: .venv tools release fmus demo test check bench example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -62,6 +62,14 @@ bench: .venv fmus
 	$(PY) tests/bench_c1.py
 	$(HARNESS) work-precision --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/work_precision.csv
+
+# The examples (examples/README.md): the flexible arm under PID control (fmpy script) and the
+# C4 parameter sweep on Dask (a local cluster of 2 workers; see examples/sweep.py --help).
+example-arm: .venv fmus
+	$(PY) examples/flexible_arm_pid/arm_pid.py
+
+example-sweep: .venv fmus
+	$(PY) examples/sweep.py
 
 clean:
 	rm -rf build .pytest_cache tests/__pycache__
