@@ -5,6 +5,7 @@
 //! [`engine::Engine`] (one FMU instance, safe) → `fmi2` (the C ABI, the only unsafe code).
 
 pub mod beam;
+pub mod effects;
 pub mod engine;
 pub mod error;
 pub mod fmi2;

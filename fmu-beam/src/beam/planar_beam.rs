@@ -14,6 +14,69 @@ use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
 use crate::scene::{BeamSpec, FrameKind};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix2, Vector2};
+use std::cell::Cell;
+
+/// Which terms a beam computes (the resolved effects of its scene, `crate::effects`). A term
+/// that is off is not evaluated at all; the full model has every term on and no truncation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BeamOptions {
+    /// Axial deformation coordinates u kept (off: the beam is inextensible, its u are removed).
+    pub axial: bool,
+    /// Quadratic-velocity (centrifugal and Coriolis) terms h(z, ż).
+    pub quadratic_velocity: bool,
+    /// Rayleigh damping D_ff q̇_f.
+    pub damping: bool,
+    /// Geometric stiffening (nonlinear axial strain); needs `axial`.
+    pub geometric_stiffening: bool,
+    /// Modal truncation: keep the lowest k modes of (K_ff, M_ff) as coordinates.
+    pub modes: Option<usize>,
+}
+
+impl Default for BeamOptions {
+    fn default() -> Self {
+        BeamOptions {
+            axial: true,
+            quadratic_velocity: true,
+            damping: true,
+            geometric_stiffening: false,
+            modes: None,
+        }
+    }
+}
+
+/// How often each optional term was evaluated (residual or tangent), so a test can prove that a
+/// term switched off costs nothing: its count stays zero.
+#[derive(Debug, Clone, Default)]
+pub struct TermCounts {
+    pub gravity: Cell<u64>,
+    pub quadratic_velocity: Cell<u64>,
+    pub damping: Cell<u64>,
+    pub geometric_stiffening: Cell<u64>,
+    pub axial: Cell<u64>,
+}
+
+impl TermCounts {
+    pub fn bump(c: &Cell<u64>) {
+        c.set(c.get() + 1);
+    }
+
+    /// Adds another body's counts into these.
+    pub fn add(&self, other: &TermCounts) {
+        for (a, b) in self.cells().into_iter().zip(other.cells()) {
+            a.set(a.get() + b.get());
+        }
+    }
+
+    fn cells(&self) -> [&Cell<u64>; 5] {
+        [
+            &self.gravity,
+            &self.quadratic_velocity,
+            &self.damping,
+            &self.geometric_stiffening,
+            &self.axial,
+        ]
+    }
+}
 
 /// Index of the angle θ in the body coordinates; q_f starts at [`FLEX`].
 pub const THETA: usize = 2;
@@ -97,6 +160,12 @@ pub struct PlanarBeam {
     pub flange_b: PointMap,
     /// Nonlinear axial strain ε = u' + v'²/2 (geometric stiffening), when on.
     pub geometric_stiffening: bool,
+    /// The terms this beam computes.
+    pub options: BeamOptions,
+    /// Modal truncation: q_nodal = Φ q_f, Φ the lowest modes (kept × k), mass-normalized.
+    pub basis: Option<DMatrix<f64>>,
+    /// Evaluations of the optional terms.
+    pub counts: TermCounts,
 }
 
 /// Full-beam integrals before the boundary conditions remove coordinates.
@@ -111,14 +180,20 @@ struct FullIntegrals {
 
 impl PlanarBeam {
     /// Builds the beam from its (validated) scene entry.
+    /// (Every term on, geometric stiffening as the scene entry says, no truncation.)
     pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
-        PlanarBeam::part_of(spec, &spec.name, spec.length)
+        let options = BeamOptions {
+            geometric_stiffening: spec.geometric_stiffening,
+            modes: spec.modes,
+            ..BeamOptions::default()
+        };
+        PlanarBeam::part_of(spec, &spec.name, spec.length, options)
     }
 
     /// One floating frame of a (validated) scene beam: the whole beam, or one of its
-    /// substructures, named `name`, of length `length`.
-    pub fn part_of(spec: &BeamSpec, name: &str, length: f64) -> PlanarBeam {
-        let mut b = PlanarBeam::new(
+    /// substructures, named `name`, of length `length`, computing the terms of `options`.
+    pub fn part_of(spec: &BeamSpec, name: &str, length: f64, options: BeamOptions) -> PlanarBeam {
+        PlanarBeam::with_options(
             name,
             length,
             crate::scene::Scene::beam_layout(spec).0,
@@ -128,11 +203,11 @@ impl PlanarBeam {
             Section::from_spec(&spec.section),
             spec.rayleigh.alpha,
             spec.rayleigh.beta,
-        );
-        b.set_geometric_stiffening(spec.geometric_stiffening);
-        b
+            options,
+        )
     }
 
+    /// The full model (every term on, no truncation).
     pub fn new(
         name: &str,
         length: f64,
@@ -144,12 +219,40 @@ impl PlanarBeam {
         rayleigh_alpha: f64,
         rayleigh_beta: f64,
     ) -> PlanarBeam {
+        PlanarBeam::with_options(
+            name,
+            length,
+            elements,
+            frame,
+            rho,
+            e,
+            section,
+            rayleigh_alpha,
+            rayleigh_beta,
+            BeamOptions::default(),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_options(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FrameKind,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+        options: BeamOptions,
+    ) -> PlanarBeam {
         let n_full = 3 * (elements + 1);
         let kept: Vec<usize> = (0..n_full)
             .filter(|&i| match frame {
                 FrameKind::Tangent => i >= 3,
                 FrameKind::Pinned => i >= 2 && i != 3 * elements + 1,
             })
+            .filter(|&i| options.axial || i % 3 != 0)
             .collect();
         let mu = rho * section.area;
         let ea = e * section.area;
@@ -174,7 +277,7 @@ impl PlanarBeam {
                 sphi: pick_v(&sphi_full),
             }
         };
-        PlanarBeam {
+        let beam = PlanarBeam {
             name: name.to_string(),
             length,
             elements,
@@ -198,13 +301,57 @@ impl PlanarBeam {
             flange_a: node_map(0, 0.0),
             flange_b: node_map(elements, length),
             kept,
-            geometric_stiffening: false,
+            geometric_stiffening: options.geometric_stiffening,
+            options,
+            basis: None,
+            counts: TermCounts::default(),
+        };
+        match options.modes {
+            Some(k) => {
+                let k = k.min(beam.kept.len());
+                beam.truncated(k)
+            }
+            None => beam,
         }
     }
 
-    /// Number of deformation coordinates nf.
+    /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
+    /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
+    fn truncated(mut self, k: usize) -> PlanarBeam {
+        let phi = lowest_modes(&self.kff, &self.mff, k);
+        let pt = phi.transpose();
+        self.sbar = &self.sbar * &phi;
+        self.a = &pt * &self.a;
+        self.b = &pt * &self.b;
+        self.w = &pt * &self.w * &phi;
+        self.mff = &pt * &self.mff * &phi;
+        self.kff = &pt * &self.kff * &phi;
+        self.dff = &self.mff * self.rayleigh_alpha + &self.kff * self.rayleigh_beta;
+        for map in [&mut self.flange_a, &mut self.flange_b] {
+            reduce_map(map, &phi);
+        }
+        self.basis = Some(phi);
+        self
+    }
+
+    /// Nodal deformation (kept coordinates) of the body coordinates z.
+    fn nodal(&self, z: &DVectorView<f64>) -> DVector<f64> {
+        let f = z.rows(FLEX, self.nflex());
+        match &self.basis {
+            Some(phi) => phi * f,
+            None => f.into_owned(),
+        }
+    }
+
+    /// True if deformation coordinate k is a nodal slope (an angle), false for a length or a
+    /// modal amplitude.
+    pub fn is_slope(&self, k: usize) -> bool {
+        self.basis.is_none() && self.kept[k] % 3 == 2
+    }
+
+    /// Number of deformation coordinates nf (nodal, or modal under truncation).
     pub fn nflex(&self) -> usize {
-        self.kept.len()
+        self.basis.as_ref().map_or(self.kept.len(), DMatrix::ncols)
     }
 
     /// Number of body coordinates 3 + nf.
@@ -267,15 +414,18 @@ impl PlanarBeam {
         m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);
     }
 
-    /// Residual r = M z̈ + h + internal - gravity, added into `r`.
+    /// Residual r = M z̈ + h + internal - gravity, added into `r`. Gravity is `None` when the
+    /// effect is off; the options say which other terms are computed.
     pub fn residual<'a>(
         &self,
         z: impl Coords<'a>,
         zd: impl Coords<'a>,
         zdd: impl Coords<'a>,
-        gravity: Vector2<f64>,
+        gravity: Option<Vector2<f64>>,
         r: &mut [f64],
     ) {
+        let (qv, damping) = (self.options.quadratic_velocity, self.options.damping);
+        self.count_terms(gravity.is_some());
         let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
@@ -289,42 +439,70 @@ impl PlanarBeam {
         let sbar_fd = self.sbar_mul(&fd);
         let sbar_fdd = self.sbar_mul(&fdd);
         // translation
-        let r_r = rdd * self.mass + athc * tdd + ar * sbar_fdd - ac * (td * td)
-            + ath * sbar_fd * (2.0 * td)
-            - gravity * self.mass;
+        let mut r_r = rdd * self.mass + athc * tdd + ar * sbar_fdd;
+        if qv {
+            r_r += ath * sbar_fd * (2.0 * td) - ac * (td * td);
+        }
+        if let Some(g) = gravity {
+            r_r -= g * self.mass;
+        }
         r[0] += r_r[0];
         r[1] += r_r[1];
         // deformation, with the sums the rotation row needs
-        let local = ar.transpose() * (rdd - gravity);
+        let local = ar.transpose() * gravity.map_or(rdd, |g| rdd - g);
         let (mut a_f, mut f_mff_f, mut mthf_fdd, mut af_fd) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..nf {
-            let (mut mff_f, mut mff_fdd, mut wt_f, mut w_fd, mut kff_f, mut dff_fd) =
-                (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            let (mut mff_f, mut mff_fdd, mut wt_f, mut kff_f) = (0.0, 0.0, 0.0, 0.0);
             for l in 0..nf {
                 mff_f += self.mff[(k, l)] * f[l];
                 mff_fdd += self.mff[(k, l)] * fdd[l];
                 wt_f += self.w[(l, k)] * f[l];
-                w_fd += self.w[(k, l)] * fd[l];
                 kff_f += self.kff[(k, l)] * f[l];
-                dff_fd += self.dff[(k, l)] * fd[l];
             }
             let mthf = self.b[k] + wt_f; // Ī_θf
-            let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
             a_f += self.a[k] * f[k];
             f_mff_f += f[k] * mff_f;
             mthf_fdd += mthf * fdd[k];
-            af_fd += af * fd[k];
-            r[FLEX + k] += col2(&self.sbar, k).dot(&local) + mthf * tdd + mff_fdd
-                - af * (td * td)
-                - w_fd * (2.0 * td)
-                + kff_f
-                + dff_fd;
+            let mut rk = col2(&self.sbar, k).dot(&local) + mthf * tdd + mff_fdd + kff_f;
+            if qv {
+                let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
+                af_fd += af * fd[k];
+                let w_fd: f64 = (0..nf).map(|l| self.w[(k, l)] * fd[l]).sum();
+                rk -= af * (td * td) + w_fd * (2.0 * td);
+            }
+            if damping {
+                rk += (0..nf).map(|l| self.dff[(k, l)] * fd[l]).sum::<f64>();
+            }
+            r[FLEX + k] += rk;
         }
         // rotation
         let mthth = self.i0 + 2.0 * a_f + f_mff_f;
-        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf_fdd + 2.0 * td * af_fd - athc.dot(&gravity);
+        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf_fdd;
+        if qv {
+            r[THETA] += 2.0 * td * af_fd;
+        }
+        if let Some(g) = gravity {
+            r[THETA] -= athc.dot(&g);
+        }
         if self.geometric_stiffening {
             self.stiffening_force(&z, &mut r[FLEX..FLEX + nf]);
+        }
+    }
+
+    /// Counts one evaluation of each optional term that is on.
+    fn count_terms(&self, gravity: bool) {
+        let c = &self.counts;
+        let o = &self.options;
+        for (on, cell) in [
+            (gravity, &c.gravity),
+            (o.quadratic_velocity, &c.quadratic_velocity),
+            (o.damping, &c.damping),
+            (self.geometric_stiffening, &c.geometric_stiffening),
+            (o.axial, &c.axial),
+        ] {
+            if on {
+                TermCounts::bump(cell);
+            }
         }
     }
 
@@ -335,10 +513,12 @@ impl PlanarBeam {
         z: impl Coords<'a>,
         zd: impl Coords<'a>,
         zdd: impl Coords<'a>,
-        gravity: Vector2<f64>,
+        gravity: Option<Vector2<f64>>,
         mut kt: DMatrixViewMut<f64>,
         mut ct: DMatrixViewMut<f64>,
     ) {
+        let (qv, damping) = (self.options.quadratic_velocity, self.options.damping);
+        self.count_terms(gravity.is_some());
         let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
@@ -352,49 +532,77 @@ impl PlanarBeam {
         let sbar_fd = self.sbar_mul(&fd);
         let sbar_fdd = self.sbar_mul(&fdd);
         // ∂r_R/∂θ
-        let d_r_th = -ac * tdd + ath * sbar_fdd - athc * (td * td) - ar * sbar_fd * (2.0 * td);
-        // ∂r_R/∂θ̇
-        let d_r_thd = -ac * (2.0 * td) + ath * sbar_fd * 2.0;
+        let mut d_r_th = -ac * tdd + ath * sbar_fdd;
+        if qv {
+            d_r_th -= athc * (td * td) + ar * sbar_fd * (2.0 * td);
+            // ∂r_R/∂θ̇
+            let d_r_thd = -ac * (2.0 * td) + ath * sbar_fd * 2.0;
+            for i in 0..2 {
+                ct[(i, THETA)] += d_r_thd[i];
+            }
+        }
         for i in 0..2 {
             kt[(i, THETA)] += d_r_th[i];
-            ct[(i, THETA)] += d_r_thd[i];
         }
         // ∂r_θ/∂θ
-        kt[(THETA, THETA)] += -ac.dot(&rdd) + ac.dot(&gravity);
+        // the frame's acceleration less gravity: the inertial load on the deformation
+        let accel = gravity.map_or(rdd, |g| rdd - g);
+        kt[(THETA, THETA)] -= ac.dot(&accel);
         let mut af_fd = 0.0;
         for k in 0..nf {
             let (asbar, athsbar) = (ar * col2(&self.sbar, k), ath * col2(&self.sbar, k));
-            let (mut mff_f, mut mff_fd, mut w_fdd, mut w_fd) = (0.0, 0.0, 0.0, 0.0);
+            let (mut mff_f, mut w_fdd) = (0.0, 0.0);
             for l in 0..nf {
                 mff_f += self.mff[(k, l)] * f[l];
-                mff_fd += self.mff[(k, l)] * fd[l];
                 w_fdd += self.w[(k, l)] * fdd[l];
-                w_fd += self.w[(k, l)] * fd[l];
             }
             let af = self.a[k] + mff_f;
-            af_fd += af * fd[k];
             // ∂r_R/∂f, ∂r_R/∂ḟ
-            let d_r_f = athsbar * tdd - asbar * (td * td);
+            let mut d_r_f = athsbar * tdd;
+            // ∂r_θ/∂f, ∂r_f/∂θ
+            let d_f_th = athsbar.dot(&accel);
+            kt[(THETA, FLEX + k)] += d_f_th + af * (2.0 * tdd) + w_fdd;
+            kt[(FLEX + k, THETA)] += d_f_th;
+            if qv {
+                let (mut mff_fd, mut w_fd) = (0.0, 0.0);
+                for l in 0..nf {
+                    mff_fd += self.mff[(k, l)] * fd[l];
+                    w_fd += self.w[(k, l)] * fd[l];
+                }
+                af_fd += af * fd[k];
+                d_r_f -= asbar * (td * td);
+                for i in 0..2 {
+                    ct[(i, FLEX + k)] += 2.0 * td * athsbar[i];
+                }
+                kt[(THETA, FLEX + k)] += mff_fd * (2.0 * td);
+                // ∂r_θ/∂ḟ, ∂r_f/∂θ̇
+                ct[(THETA, FLEX + k)] += 2.0 * td * af;
+                ct[(FLEX + k, THETA)] += af * (-2.0 * td) - w_fd * 2.0;
+            }
             for i in 0..2 {
                 kt[(i, FLEX + k)] += d_r_f[i];
-                ct[(i, FLEX + k)] += 2.0 * td * athsbar[i];
             }
-            // ∂r_θ/∂f, ∂r_f/∂θ
-            let d_f_th = athsbar.dot(&(rdd - gravity));
-            kt[(THETA, FLEX + k)] += d_f_th + af * (2.0 * tdd) + w_fdd + mff_fd * (2.0 * td);
-            kt[(FLEX + k, THETA)] += d_f_th;
-            // ∂r_θ/∂ḟ, ∂r_f/∂θ̇
-            ct[(THETA, FLEX + k)] += 2.0 * td * af;
-            ct[(FLEX + k, THETA)] += af * (-2.0 * td) - w_fd * 2.0;
         }
-        ct[(THETA, THETA)] += 2.0 * af_fd;
+        if qv {
+            ct[(THETA, THETA)] += 2.0 * af_fd;
+        }
         // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff, ∂r_f/∂ḟ = -2θ̇ W + D_ff
         for l in 0..nf {
             for k in 0..nf {
-                kt[(FLEX + k, FLEX + l)] +=
-                    self.w[(l, k)] * tdd - td * td * self.mff[(k, l)] + self.kff[(k, l)];
-                ct[(FLEX + k, FLEX + l)] += -2.0 * td * self.w[(k, l)] + self.dff[(k, l)];
+                kt[(FLEX + k, FLEX + l)] += self.w[(l, k)] * tdd + self.kff[(k, l)];
             }
+        }
+        if qv {
+            for l in 0..nf {
+                for k in 0..nf {
+                    kt[(FLEX + k, FLEX + l)] -= td * td * self.mff[(k, l)];
+                    ct[(FLEX + k, FLEX + l)] -= 2.0 * td * self.w[(k, l)];
+                }
+            }
+        }
+        if damping {
+            let mut c = ct.view_mut((FLEX, FLEX), (nf, nf));
+            c += &self.dff;
         }
         if self.geometric_stiffening {
             self.stiffening_tangent(&z, &mut kt);
@@ -423,7 +631,8 @@ impl PlanarBeam {
     }
 
     /// Potential energy of gravity -g·∫ρ r dV (J).
-    pub fn gravity_energy<'a>(&self, z: impl Coords<'a>, gravity: Vector2<f64>) -> f64 {
+    pub fn gravity_energy<'a>(&self, z: impl Coords<'a>, gravity: Option<Vector2<f64>>) -> f64 {
+        let Some(gravity) = gravity else { return 0.0 };
         let z = z.into();
         let f = z.rows(FLEX, self.nflex());
         let (ar, _) = rot(z[THETA]);
@@ -455,9 +664,9 @@ impl PlanarBeam {
         let xi = (x / l - j as f64).clamp(0.0, 1.0);
         let (s1, s2) = planar_element::shape(xi, l);
         let sl = planar_element::slope(xi, l);
-        let nf = self.nflex();
-        let mut sp = DMatrix::zeros(2, nf);
-        let mut sphi = DVector::zeros(nf);
+        let nk = self.kept.len();
+        let mut sp = DMatrix::zeros(2, nk);
+        let mut sphi = DVector::zeros(nk);
         for p in 0..ELEMENT_DOFS {
             if let Some(k) = self.flex_index(3 * j + p) {
                 sp[(0, k)] = s1[p];
@@ -465,11 +674,15 @@ impl PlanarBeam {
                 sphi[k] = sl[p];
             }
         }
-        PointMap {
+        let mut map = PointMap {
             s0: Vector2::new(x, 0.0),
             sp,
             sphi,
+        };
+        if let Some(phi) = &self.basis {
+            reduce_map(&mut map, phi);
         }
+        map
     }
 
     pub fn set_geometric_stiffening(&mut self, on: bool) {
@@ -482,7 +695,7 @@ impl PlanarBeam {
     #[allow(clippy::type_complexity)]
     fn for_element_strains(
         &self,
-        z: &DVectorView<f64>,
+        fq: &DVector<f64>,
         mut visit: impl FnMut(
             &[Option<usize>; ELEMENT_DOFS],
             f64,
@@ -497,7 +710,7 @@ impl PlanarBeam {
             let idx: [Option<usize>; ELEMENT_DOFS] =
                 std::array::from_fn(|p| self.flex_index(3 * j + p));
             let qe: [f64; ELEMENT_DOFS] =
-                std::array::from_fn(|p| idx[p].map_or(0.0, |k| z[FLEX + k]));
+                std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
             let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
             let mut de = da;
             let mut hv = [[0.0; ELEMENT_DOFS]; ELEMENT_DOFS];
@@ -517,44 +730,61 @@ impl PlanarBeam {
     }
 
     /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
-    /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out`.
+    /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out` (projected on the modes under
+    /// truncation).
     fn stiffening_force(&self, z: &DVectorView<f64>, out: &mut [f64]) {
         let ea = self.ea;
-        self.for_element_strains(z, |idx, l, eps, de, _| {
-            let du =
-                (idx[3].map_or(0.0, |k| z[FLEX + k]) - idx[0].map_or(0.0, |k| z[FLEX + k])) / l;
+        let fq = self.nodal(z);
+        let mut nodal = DVector::zeros(self.kept.len());
+        self.for_element_strains(&fq, |idx, l, eps, de, _| {
+            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
             let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 if let Some(k) = idx[p] {
-                    out[k] += ea * l * (eps * de[p] - du * da[p]);
+                    nodal[k] += ea * l * (eps * de[p] - du * da[p]);
                 }
             }
         });
+        let projected = match &self.basis {
+            Some(phi) => phi.tr_mul(&nodal),
+            None => nodal,
+        };
+        for (o, x) in out.iter_mut().zip(projected.iter()) {
+            *o += x;
+        }
     }
 
     /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
     fn stiffening_tangent(&self, z: &DVectorView<f64>, kt: &mut DMatrixViewMut<f64>) {
         let ea = self.ea;
-        self.for_element_strains(z, |idx, l, eps, de, hv| {
+        let fq = self.nodal(z);
+        let nk = self.kept.len();
+        let mut nodal = DMatrix::zeros(nk, nk);
+        self.for_element_strains(&fq, |idx, l, eps, de, hv| {
             let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 let Some(kp) = idx[p] else { continue };
                 for r in 0..ELEMENT_DOFS {
                     let Some(kr) = idx[r] else { continue };
-                    kt[(FLEX + kp, FLEX + kr)] +=
-                        ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
+                    nodal[(kp, kr)] += ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
                 }
             }
         });
+        let nf = self.nflex();
+        let mut block = kt.view_mut((FLEX, FLEX), (nf, nf));
+        match &self.basis {
+            Some(phi) => block += phi.tr_mul(&nodal) * phi,
+            None => block += nodal,
+        }
     }
 
     /// Strain energy of the nonlinear strain beyond ½ q_fᵀ K_ff q_f.
     fn stiffening_energy(&self, z: &DVectorView<f64>) -> f64 {
         let mut e = 0.0;
         let ea = self.ea;
-        self.for_element_strains(z, |idx, l, eps, _, _| {
-            let du =
-                (idx[3].map_or(0.0, |k| z[FLEX + k]) - idx[0].map_or(0.0, |k| z[FLEX + k])) / l;
+        let fq = self.nodal(z);
+        self.for_element_strains(&fq, |idx, l, eps, _, _| {
+            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
             e += 0.5 * ea * l * (eps * eps - du * du);
         });
         e
@@ -562,12 +792,15 @@ impl PlanarBeam {
 
     /// Static deformation under a transverse tip force, scaled to a tip displacement `tip`
     /// (tangent frame): the initial shape of case C1.
+    /// Under modal truncation the shape is the static solution within the kept modes.
     pub fn static_tip_shape(&self, tip: f64) -> Option<DVector<f64>> {
-        let iv = self.flex_index(3 * self.elements + 1)?;
-        let mut load = DVector::zeros(self.nflex());
-        load[iv] = 1.0;
+        // the tip's transverse displacement per coordinate: the unit tip load, by reciprocity
+        let load = self.flange_b.sp.row(1).transpose();
+        if load.amax() == 0.0 {
+            return None; // the frame holds the tip
+        }
         let q = self.kff.clone().lu().solve(&load)?;
-        let scale = tip / q[iv];
+        let scale = tip / load.dot(&q);
         scale.is_finite().then(|| q * scale)
     }
 }
@@ -609,4 +842,34 @@ fn full_integrals(length: f64, elements: usize, mu: f64, ea: f64, ej: f64) -> Fu
         }
     }
     out
+}
+
+/// Expresses a point map in modal coordinates: S_p Φ and Φᵀ S_φ.
+fn reduce_map(map: &mut PointMap, phi: &DMatrix<f64>) {
+    map.sp = &map.sp * phi;
+    map.sphi = phi.tr_mul(&map.sphi);
+}
+
+/// The lowest `k` modes of K φ = ω² M φ (columns, ascending ω, Φᵀ M Φ = I), through the
+/// Cholesky factor of the (positive definite) mass matrix.
+pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix<f64> {
+    let l = mff
+        .clone()
+        .cholesky()
+        .expect("the consistent mass matrix is positive definite")
+        .l();
+    let linv = l
+        .clone()
+        .try_inverse()
+        .expect("a Cholesky factor is invertible");
+    let a = &linv * kff * linv.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = a.symmetric_eigen();
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let cols: Vec<_> = order[..k]
+        .iter()
+        .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
+        .collect();
+    DMatrix::from_columns(&cols)
 }

@@ -2,7 +2,7 @@
 //! floating-frame kinematics r = R + A(θ) (s0 + S_p q_f); a rigid body has no q_f.
 
 use super::rigid_body::RigidBody;
-use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, FLEX, THETA};
+use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, TermCounts, FLEX, THETA};
 use nalgebra::{DMatrixViewMut, DVectorView, Vector2};
 
 #[derive(Debug, Clone)]
@@ -42,15 +42,24 @@ impl Body {
         }
     }
 
+    /// How often this body evaluated each optional term.
+    pub fn counts(&self) -> &TermCounts {
+        match self {
+            Body::Beam(b) => &b.counts,
+            Body::Rigid(r) => &r.counts,
+        }
+    }
+
     /// A rigid body without mass and inertia (its coordinates are fixed by joints).
     pub fn is_massless(&self) -> bool {
         matches!(self, Body::Rigid(r) if r.mass == 0.0 && r.inertia == 0.0)
     }
 
-    /// True for coordinates that are angles (θ, nodal slopes); false for lengths.
+    /// True for coordinates that are angles (θ, nodal slopes); false for lengths and modal
+    /// amplitudes.
     pub fn is_angle(&self, k: usize) -> bool {
         match self {
-            Body::Beam(b) => k == THETA || (k >= FLEX && b.kept[k - FLEX] % 3 == 2),
+            Body::Beam(b) => k == THETA || (k >= FLEX && b.is_slope(k - FLEX)),
             Body::Rigid(_) => k == THETA,
         }
     }
@@ -67,7 +76,7 @@ impl Body {
         z: DVectorView<f64>,
         zd: DVectorView<f64>,
         zdd: DVectorView<f64>,
-        g: Vector2<f64>,
+        g: Option<Vector2<f64>>,
         out: &mut [f64],
     ) {
         match self {
@@ -81,7 +90,7 @@ impl Body {
         z: DVectorView<f64>,
         zd: DVectorView<f64>,
         zdd: DVectorView<f64>,
-        g: Vector2<f64>,
+        g: Option<Vector2<f64>>,
         kt: DMatrixViewMut<f64>,
         ct: DMatrixViewMut<f64>,
     ) {
@@ -105,7 +114,7 @@ impl Body {
         }
     }
 
-    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Vector2<f64>) -> f64 {
+    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Option<Vector2<f64>>) -> f64 {
         match self {
             Body::Beam(b) => b.gravity_energy(z, g),
             Body::Rigid(r) => r.gravity_energy(z, g),

@@ -2,7 +2,7 @@
 //! c̄ in that frame. A body of zero mass is allowed when joints fix all its coordinates
 //! (the massless slider of case C3): its block of the mass matrix is zero.
 
-use crate::beam::planar_beam::{rot, PointMap};
+use crate::beam::planar_beam::{rot, PointMap, TermCounts};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Vector2};
 
 #[derive(Debug, Clone)]
@@ -15,6 +15,8 @@ pub struct RigidBody {
     pub inertia: f64,
     /// Named frames: position in the body frame.
     pub frames: Vec<(String, Vector2<f64>)>,
+    /// Evaluations of the optional terms (gravity only, for a rigid body).
+    pub counts: TermCounts,
 }
 
 impl RigidBody {
@@ -56,19 +58,22 @@ impl RigidBody {
         z: DVectorView<f64>,
         zd: DVectorView<f64>,
         zdd: DVectorView<f64>,
-        g: Vector2<f64>,
+        gravity: Option<Vector2<f64>>,
         r: &mut [f64],
     ) {
         let (ar, ath) = rot(z[2]);
         let (pd, pdd) = (zd[2], zdd[2]);
         let c = self.com * self.mass;
-        let rr = Vector2::new(zdd[0], zdd[1]) * self.mass + ath * c * pdd
-            - ar * c * (pd * pd)
-            - g * self.mass;
+        let mut rr = Vector2::new(zdd[0], zdd[1]) * self.mass + ath * c * pdd - ar * c * (pd * pd);
+        let mut accel = Vector2::new(zdd[0], zdd[1]);
+        if let Some(g) = gravity {
+            TermCounts::bump(&self.counts.gravity);
+            rr -= g * self.mass;
+            accel -= g;
+        }
         r[0] += rr[0];
         r[1] += rr[1];
-        r[2] += (ath * c).dot(&(Vector2::new(zdd[0], zdd[1]) - g))
-            + (self.inertia + self.mass * self.com.norm_squared()) * pdd;
+        r[2] += (ath * c).dot(&accel) + (self.inertia + self.mass * self.com.norm_squared()) * pdd;
     }
 
     /// K_t = ∂r/∂z and C_t = ∂r/∂ż, added.
@@ -77,12 +82,17 @@ impl RigidBody {
         z: DVectorView<f64>,
         zd: DVectorView<f64>,
         zdd: DVectorView<f64>,
-        g: Vector2<f64>,
+        gravity: Option<Vector2<f64>>,
         mut kt: DMatrixViewMut<f64>,
         mut ct: DMatrixViewMut<f64>,
     ) {
         let (ar, ath) = rot(z[2]);
         let (pd, pdd) = (zd[2], zdd[2]);
+        let mut accel = Vector2::new(zdd[0], zdd[1]);
+        if let Some(g) = gravity {
+            TermCounts::bump(&self.counts.gravity);
+            accel -= g;
+        }
         let c = self.com * self.mass;
         let d_r_phi = -ar * c * pdd - ath * c * (pd * pd);
         let d_r_phid = -ar * c * (2.0 * pd);
@@ -90,7 +100,7 @@ impl RigidBody {
             kt[(i, 2)] += d_r_phi[i];
             ct[(i, 2)] += d_r_phid[i];
         }
-        kt[(2, 2)] += -(ar * c).dot(&(Vector2::new(zdd[0], zdd[1]) - g));
+        kt[(2, 2)] += -(ar * c).dot(&accel);
     }
 
     pub fn kinetic_energy(&self, z: DVectorView<f64>, zd: DVectorView<f64>) -> f64 {
@@ -99,7 +109,8 @@ impl RigidBody {
         0.5 * zd.dot(&(&m * zd))
     }
 
-    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Vector2<f64>) -> f64 {
+    pub fn gravity_energy(&self, z: DVectorView<f64>, g: Option<Vector2<f64>>) -> f64 {
+        let Some(g) = g else { return 0.0 };
         let (ar, _) = rot(z[2]);
         -g.dot(&((Vector2::new(z[0], z[1]) + ar * self.com) * self.mass))
     }

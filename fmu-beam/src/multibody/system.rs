@@ -9,6 +9,8 @@ use super::joint::{Drive, Joint, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
 use crate::beam::planar_beam::{rot, PlanarBeam, PointMap};
+use crate::beam::planar_beam::TermCounts;
+use crate::effects::Effects;
 use crate::error::EngineError;
 use crate::scene::{DriveKind, JointKind, Scene};
 use nalgebra::{DMatrix, DVector, DVectorView, Vector2};
@@ -105,7 +107,10 @@ pub struct System {
     pub joints: Vec<Joint>,
     pub loads: Vec<Load>,
     pub beams: Vec<BeamGroup>,
-    pub gravity: Vector2<f64>,
+    /// The gravity field, `None` when the effect is off (its terms are not evaluated).
+    pub gravity: Option<Vector2<f64>>,
+    /// The resolved effects the system was built with.
+    pub effects: Effects,
     /// Current values of the FMU inputs (slot order of [`input_slots`]).
     pub inputs: Vec<InputValue>,
     n: usize,
@@ -113,15 +118,22 @@ pub struct System {
 }
 
 impl System {
-    /// Assembles the system of a validated scene.
+    /// Assembles the system of a validated scene with the effects the scene resolves to.
     pub fn from_scene(scene: &Scene) -> System {
+        System::build(scene, &crate::effects::resolve(scene).effects)
+    }
+
+    /// Assembles the system of a validated scene computing the given effects (resolved from
+    /// this scene, or from the packaged scene of which this one has other parameter values).
+    pub fn build(scene: &Scene, effects: &Effects) -> System {
         let mut bodies = Vec::new();
         let mut beams = Vec::new();
-        for spec in &scene.beams {
+        for (spec, fx) in scene.beams.iter().zip(&effects.beams) {
             let (_, k) = Scene::beam_layout(spec);
+            let k = if fx.rigid { 1 } else { k };
             let first = bodies.len();
             let section = crate::beam::section::Section::from_spec(&spec.section);
-            if spec.rigid {
+            if fx.rigid {
                 let mass = spec.material.rho * section.area * spec.length;
                 bodies.push(Body::Rigid(RigidBody {
                     name: spec.name.clone(),
@@ -132,6 +144,7 @@ impl System {
                         ("a".into(), Vector2::zeros()),
                         ("b".into(), Vector2::new(spec.length, 0.0)),
                     ],
+                    counts: Default::default(),
                 }));
             } else {
                 let ls = spec.length / k as f64;
@@ -141,7 +154,7 @@ impl System {
                     } else {
                         format!("{}[{i}]", spec.name)
                     };
-                    let b = PlanarBeam::part_of(spec, &name, ls);
+                    let b = PlanarBeam::part_of(spec, &name, ls, fx.options);
                     bodies.push(Body::Beam(Box::new(b)));
                 }
             }
@@ -178,6 +191,7 @@ impl System {
                     .iter()
                     .map(|(n, p)| (n.clone(), Vector2::new(p[0], p[1])))
                     .collect(),
+                counts: Default::default(),
             }));
         }
         let mut offsets = Vec::with_capacity(bodies.len());
@@ -193,7 +207,10 @@ impl System {
             joints: Vec::new(),
             loads: Vec::new(),
             beams,
-            gravity: Vector2::new(scene.world.gravity[0], scene.world.gravity[1]),
+            gravity: effects
+                .gravity
+                .then(|| Vector2::new(scene.world.gravity[0], scene.world.gravity[1])),
+            effects: effects.clone(),
             inputs: input_slots(scene)
                 .iter()
                 .map(|s| InputValue {
@@ -666,6 +683,15 @@ impl System {
             e.potential += b.gravity_energy(z, self.gravity);
         }
         e
+    }
+
+    /// Evaluations of each optional term, summed over the bodies.
+    pub fn term_counts(&self) -> TermCounts {
+        let total = TermCounts::default();
+        for b in &self.bodies {
+            total.add(b.counts());
+        }
+        total
     }
 
     /// Names of the joints whose equations are in the given constraint rows.

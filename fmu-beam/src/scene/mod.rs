@@ -33,6 +33,24 @@ pub struct Scene {
     pub joints: Vec<JointSpec>,
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadSpec>,
+    /// What to simulate: `"all"` (default), `"auto"`, or a list of effect names
+    /// (`crate::effects::EFFECTS`).
+    #[serde(default)]
+    pub effects: EffectsSpec,
+}
+
+/// The scene's `effects`: a mode (`"all"`, `"auto"`) or the list of effects to simulate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum EffectsSpec {
+    Mode(String),
+    List(Vec<String>),
+}
+
+impl Default for EffectsSpec {
+    fn default() -> Self {
+        EffectsSpec::Mode("all".into())
+    }
 }
 
 /// The world: its gravity field (m/s^2, world axes).
@@ -137,6 +155,9 @@ pub struct BeamSpec {
     /// Adds the geometric stiffness of the axial force (nonlinear strain u' + v'^2/2).
     #[serde(default)]
     pub geometric_stiffening: bool,
+    /// Modal truncation: keep the lowest `modes` modes of each frame's deformation.
+    #[serde(default)]
+    pub modes: Option<usize>,
     /// Reference frame of the deformation field (planar paper §3.3).
     #[serde(default)]
     pub frame: FrameKind,

@@ -1,9 +1,10 @@
 //! Value rules of a scene. Each error names the file, the field and the rule.
 
 use super::{
-    BeamSpec, DriveKind, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene, SectionSpec,
-    BEAM_OUTPUTS,
+    BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
+    SectionSpec, BEAM_OUTPUTS,
 };
+use crate::effects::EFFECTS;
 use thiserror::Error;
 
 /// Why a scene was refused.
@@ -118,6 +119,7 @@ impl Scene {
                 ));
             }
         }
+        validate_effects(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
             validate_body(&ck, b, i)?;
         }
@@ -236,6 +238,55 @@ impl Scene {
     }
 }
 
+/// `effects`: a known mode or a list of known, distinct effects that fit the beams.
+fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
+    let names = match &scene.effects {
+        EffectsSpec::Mode(m) if m == "all" || m == "auto" => return Ok(()),
+        EffectsSpec::Mode(m) => {
+            return Err(ck.fail(
+                "effects",
+                format!("{m:?}"),
+                "must be \"all\", \"auto\" or a list of effects",
+            ))
+        }
+        EffectsSpec::List(names) => names,
+    };
+    let known: Vec<&str> = EFFECTS.iter().map(|(n, _)| *n).collect();
+    for (k, n) in names.iter().enumerate() {
+        if !known.contains(&n.as_str()) {
+            return Err(ck.fail(
+                &format!("effects[{k}]"),
+                format!("{n:?}"),
+                &format!("is not an effect; the effects are {}", known.join(", ")),
+            ));
+        }
+        if names[..k].contains(n) {
+            return Err(ck.fail(&format!("effects[{k}]"), format!("{n:?}"), "is listed twice"));
+        }
+    }
+    let on = |e: &str| names.iter().any(|n| n == e);
+    for (i, b) in scene.beams.iter().enumerate() {
+        if !on("flexibility") && b.initial.tip_displacement != 0.0 {
+            return Err(ck.fail(
+                &format!("beam[{i}].initial.tip_displacement"),
+                b.initial.tip_displacement,
+                "needs the effect \"flexibility\" (a rigid beam cannot start deformed)",
+            ));
+        }
+        if on("geometric_stiffening") && b.geometric_stiffening && !on("axial") {
+            return Err(ck.fail(
+                "effects",
+                format!("{names:?}"),
+                &format!(
+                    "beam {} asks for geometric stiffening, which needs the effect \"axial\"",
+                    b.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError> {
     let f = |name: &str| format!("beam[{i}].{name}");
     if !is_identifier(&b.name) {
@@ -300,6 +351,20 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError>
             true,
             "a rigid beam has no substructures, stiffening or initial deformation",
         ));
+    }
+    if let Some(m) = b.modes {
+        let (elements, _) = Scene::beam_layout(b);
+        let nodal = 3 * elements; // the frame removes 3 of the 3 (N + 1) nodal coordinates
+        if m == 0 || m > nodal || b.rigid {
+            return Err(ck.fail(
+                &f("modes"),
+                m,
+                &format!(
+                    "must lie between 1 and the {nodal} deformation coordinates of a frame \
+                     of a flexible beam"
+                ),
+            ));
+        }
     }
     ck.positive(&f("material.rho"), b.material.rho)?;
     ck.positive(&f("material.E"), b.material.e)?;

@@ -1,0 +1,619 @@
+//! Effects: which physical terms a scene's unit computes, and why.
+//!
+//! A scene's `effects` is `"all"` (the default: every term of the model as the scene's entries
+//! describe it), a list of effect names (exactly those are on), or `"auto"` (decided here from
+//! the scene: its gravity field, what its drives and loads excite, how fast its beams spin).
+//! [`resolve`] turns that into [`Effects`] (what [`crate::multibody::System`] builds) and a list
+//! of [`Decision`]s with the reason for each and its estimated share of the cost of a step
+//! (what `fmu-harness explain` prints and the FMU carries in `documentation/`). A term that is
+//! off is not evaluated: the beam's [`BeamOptions`] switch its code path off.
+
+use crate::beam::planar_beam::BeamOptions;
+use crate::beam::section::Section;
+use crate::scene::{BeamSpec, DriveKind, FrameKind, JointKind, LawSpec, Scene};
+use std::collections::BTreeSet;
+use std::f64::consts::PI;
+
+/// The effects a list may name, with what each one is.
+pub const EFFECTS: [(&str, &str); 6] = [
+    ("gravity", "the gravity field of world.gravity"),
+    (
+        "flexibility",
+        "deformation of the beams (off: every beam is a rigid bar)",
+    ),
+    ("axial", "axial deformation of the beams (off: inextensible)"),
+    (
+        "quadratic_velocity",
+        "centrifugal and Coriolis terms of the beams' deformation",
+    ),
+    (
+        "geometric_stiffening",
+        "the geometric stiffness of the beams that ask for it (`geometric_stiffening = true`)",
+    ),
+    ("rayleigh_damping", "Rayleigh damping of the beams"),
+];
+
+/// Modes a beam keeps when `auto` finds its response quasi-static.
+pub const AUTO_MODES: usize = 4;
+/// `auto`: a beam whose first bending frequency is this many times above the excitation
+/// bandwidth responds quasi-statically (a few modes carry it).
+pub const QUASI_STATIC_RATIO: f64 = 10.0;
+/// `auto`: spin above this fraction of the first bending frequency needs geometric stiffening
+/// (the first frequency then rises by more than ≈ 5 %).
+pub const SPIN_RATIO: f64 = 0.3;
+
+/// The resolved effects: what the system computes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Effects {
+    pub gravity: bool,
+    /// One entry per scene beam, in scene order.
+    pub beams: Vec<BeamEffects>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamEffects {
+    /// A rigid bar (no deformation coordinates).
+    pub rigid: bool,
+    /// The terms of the flexible beam (ignored when rigid).
+    pub options: BeamOptions,
+}
+
+/// One resolved effect of one subject (the scene, or a beam), with its reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decision {
+    pub effect: &'static str,
+    /// `scene` or the beam's name.
+    pub subject: String,
+    /// `on`, `off`, or a setting (`4 modes`, `5 x 4 elements`).
+    pub setting: String,
+    pub why: String,
+    /// Estimated share of a step's cost that this effect adds (0..1): the operation count with
+    /// it, less the count without it, over the count with every resolved effect.
+    pub cost_share: f64,
+}
+
+/// Everything `resolve` found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resolution {
+    /// `all`, `auto` or `list`.
+    pub mode: &'static str,
+    pub effects: Effects,
+    pub decisions: Vec<Decision>,
+}
+
+impl Resolution {
+    /// The explanation as text: one line per decision, then the cost model's total.
+    pub fn explain(&self, scene: &Scene) -> String {
+        let mut s = format!(
+            "Effects of scene '{}' (effects = {}):\n\n",
+            scene.name, self.mode
+        );
+        let w = self
+            .decisions
+            .iter()
+            .map(|d| d.effect.len() + d.subject.len() + 3)
+            .max()
+            .unwrap_or(10);
+        let ws = self
+            .decisions
+            .iter()
+            .map(|d| d.setting.len())
+            .max()
+            .unwrap_or(3);
+        s += &format!(
+            "{:<w$}  {:<ws$}  {:>6}  why\n",
+            "effect (subject)", "setting", "cost"
+        );
+        for d in &self.decisions {
+            let name = format!("{} ({})", d.effect, d.subject);
+            s += &format!(
+                "{name:<w$}  {:<ws$}  {:>5.1}%  {}\n",
+                d.setting,
+                100.0 * d.cost_share,
+                d.why
+            );
+        }
+        s += &format!(
+            "\ncost: the share of the operations of one step (residual, tangents, LU of the \
+             iteration matrix) that the effect adds, from an operation count of the resolved \
+             system ({} coordinates); `make bench` measures the time.\n",
+            coordinates(scene, &self.effects)
+        );
+        s
+    }
+}
+
+/// First bending natural frequency (rad/s) of a beam alone: clamped–free for a tangent frame,
+/// pinned–pinned for a pinned one (Euler–Bernoulli closed forms).
+pub fn first_bending_frequency(b: &BeamSpec) -> f64 {
+    let sec = Section::from_spec(&b.section);
+    let mu = b.material.rho * sec.area;
+    let ej = b.material.e * sec.second_moment;
+    let beta_l: f64 = match b.frame {
+        FrameKind::Tangent => 1.875_104_068_711_961,
+        FrameKind::Pinned => PI,
+    };
+    beta_l * beta_l * (ej / (mu * b.length.powi(4))).sqrt()
+}
+
+/// Bandwidth (rad/s) a time law excites; infinite for a jump in the law or in its rate.
+fn law_bandwidth(law: &LawSpec, kind: DriveKind, comm_step: f64) -> f64 {
+    if law.until.is_some() {
+        return f64::INFINITY; // the law drops to zero: a jump
+    }
+    match law.law.as_str() {
+        "constant" => match kind {
+            DriveKind::Motion => 0.0,
+            DriveKind::Effort if law.value.unwrap_or(0.0) == 0.0 => 0.0,
+            DriveKind::Effort => f64::INFINITY, // a step at t = 0
+        },
+        // the value is continuous but its rate jumps at t = 0 (a motion drive) or the effort
+        // itself starts with a finite slope: take it as a jump for motion, 1/τ for effort
+        "exponential" => match kind {
+            DriveKind::Motion => f64::INFINITY,
+            DriveKind::Effort => 1.0 / law.time_constant.unwrap_or(1.0),
+        },
+        "spin_up" => 2.0 * PI / law.ramp_time.unwrap_or(1.0),
+        "table" => {
+            let t = law.table.as_deref().unwrap_or(&[]);
+            let dt = t
+                .windows(2)
+                .map(|w| w[1][0] - w[0][0])
+                .fold(f64::INFINITY, f64::min);
+            2.0 * PI / dt
+        }
+        // an input may change every communication step
+        _ => PI / comm_step,
+    }
+}
+
+/// Largest rate (rad/s) of a revolute motion drive's law.
+fn law_max_rate(law: &LawSpec) -> f64 {
+    match law.law.as_str() {
+        "spin_up" => law.omega.unwrap_or(0.0).abs(),
+        "exponential" => law.value.unwrap_or(0.0).abs() / law.time_constant.unwrap_or(1.0),
+        "table" => law
+            .table
+            .as_deref()
+            .unwrap_or(&[])
+            .windows(2)
+            .map(|w| ((w[1][1] - w[0][1]) / (w[1][0] - w[0][0])).abs())
+            .fold(0.0, f64::max),
+        _ => 0.0,
+    }
+}
+
+/// What excites the scene: the bandwidth (rad/s) and the source that sets it.
+fn excitation(scene: &Scene) -> (f64, String) {
+    let h = scene.experiment.step_size;
+    let mut worst = (0.0, "nothing: no drive, load or gravity acts".to_string());
+    let mut consider = |w: f64, what: String| {
+        if w > worst.0 {
+            worst = (w, what);
+        }
+    };
+    if scene.world.gravity != [0.0, 0.0] {
+        consider(
+            f64::INFINITY,
+            "gravity, switched on at t = 0 (a step)".into(),
+        );
+    }
+    for j in &scene.joints {
+        if let Some(d) = &j.drive {
+            let w = law_bandwidth(&d.law, d.kind, h);
+            consider(w, format!("the {} law of joint {}", d.law.law, j.name));
+        }
+    }
+    for l in &scene.loads {
+        if l.input {
+            consider(PI / h, format!("load {} (an input)", l.name));
+        } else if l.force != [0.0, 0.0] || l.torque != 0.0 {
+            consider(f64::INFINITY, format!("load {} (a step at t = 0)", l.name));
+        }
+    }
+    worst
+}
+
+/// Names of the bodies and beams that never rotate: the world, and whatever a weld or a
+/// prismatic joint holds to something that never rotates.
+fn non_rotating(scene: &Scene) -> BTreeSet<String> {
+    let owner = |f: &str| f.split_once('.').map_or(f, |(o, _)| o).to_string();
+    let mut fixed = BTreeSet::from(["world".to_string()]);
+    loop {
+        let before = fixed.len();
+        for j in &scene.joints {
+            if !matches!(j.kind, JointKind::Weld | JointKind::Prismatic) {
+                continue;
+            }
+            let (a, b) = (owner(&j.frames[0]), owner(&j.frames[1]));
+            if fixed.contains(&a) {
+                fixed.insert(b.clone());
+            }
+            if fixed.contains(&b) {
+                fixed.insert(a);
+            }
+        }
+        if fixed.len() == before {
+            return fixed;
+        }
+    }
+}
+
+/// Resolves the effects of a validated scene.
+pub fn resolve(scene: &Scene) -> Resolution {
+    let all = || BeamOptions::default();
+    match &scene.effects {
+        crate::scene::EffectsSpec::List(names) => {
+            let on = |e: &str| names.iter().any(|n| n == e);
+            let effects = Effects {
+                gravity: on("gravity"),
+                beams: scene
+                    .beams
+                    .iter()
+                    .map(|b| BeamEffects {
+                        rigid: b.rigid || !on("flexibility"),
+                        options: BeamOptions {
+                            axial: on("axial"),
+                            quadratic_velocity: on("quadratic_velocity"),
+                            damping: on("rayleigh_damping"),
+                            geometric_stiffening: b.geometric_stiffening
+                                && on("geometric_stiffening"),
+                            modes: b.modes,
+                        },
+                    })
+                    .collect(),
+            };
+            finish(scene, "list", effects, |_, _| "listed in `effects`".into())
+        }
+        crate::scene::EffectsSpec::Mode(m) if m == "auto" => auto(scene),
+        crate::scene::EffectsSpec::Mode(_) => {
+            let effects = Effects {
+                gravity: true,
+                beams: scene
+                    .beams
+                    .iter()
+                    .map(|b| BeamEffects {
+                        rigid: b.rigid,
+                        options: BeamOptions {
+                            geometric_stiffening: b.geometric_stiffening,
+                            modes: b.modes,
+                            ..all()
+                        },
+                    })
+                    .collect(),
+            };
+            finish(scene, "all", effects, |_, _| {
+                "effects = \"all\" (the default): the full model".into()
+            })
+        }
+    }
+}
+
+/// `effects = "auto"`: the rules of the module documentation, each decision with its reason.
+fn auto(scene: &Scene) -> Resolution {
+    let mut why: Vec<(&'static str, String, String)> = Vec::new();
+    let gravity = scene.world.gravity != [0.0, 0.0];
+    why.push((
+        "gravity",
+        "scene".into(),
+        if gravity {
+            format!("world.gravity = {:?} m/s2", scene.world.gravity)
+        } else {
+            "no gravity field".into()
+        },
+    ));
+    let (bandwidth, source) = excitation(scene);
+    let still = non_rotating(scene);
+    let spin = scene
+        .joints
+        .iter()
+        .filter(|j| j.kind == JointKind::Revolute)
+        .filter_map(|j| j.drive.as_ref().filter(|d| d.kind == DriveKind::Motion))
+        .map(|d| law_max_rate(&d.law))
+        .fold(0.0, f64::max);
+    let mut beams = Vec::new();
+    for b in &scene.beams {
+        let w1 = first_bending_frequency(b);
+        let n = b.name.clone();
+        let mut o = BeamOptions {
+            geometric_stiffening: b.geometric_stiffening,
+            modes: b.modes,
+            ..BeamOptions::default()
+        };
+        // geometric stiffening: a single-frame beam spinning near its first frequency
+        if b.substructures.is_none() && !b.rigid && spin >= SPIN_RATIO * w1 {
+            o.geometric_stiffening = true;
+            why.push((
+                "geometric_stiffening",
+                n.clone(),
+                format!(
+                    "spin up to {spin:.3} rad/s is {:.2} x the first bending frequency \
+                     {w1:.3} rad/s (>= {SPIN_RATIO}): centrifugal stiffening matters",
+                    spin / w1
+                ),
+            ));
+        } else if o.geometric_stiffening {
+            why.push((
+                "geometric_stiffening",
+                n.clone(),
+                "asked for by the beam".into(),
+            ));
+        } else {
+            why.push((
+                "geometric_stiffening",
+                n.clone(),
+                if b.substructures.is_some() {
+                    "substructures carry the large rotations (planar paper §3.4)".into()
+                } else {
+                    format!(
+                        "spin {spin:.3} rad/s is below {SPIN_RATIO} x the first bending \
+                         frequency {w1:.3} rad/s"
+                    )
+                },
+            ));
+        }
+        // axial deformation: only where the stiffening needs the axial strain
+        o.axial = o.geometric_stiffening;
+        why.push((
+            "axial",
+            n.clone(),
+            if o.axial {
+                "geometric stiffening needs the axial strain".into()
+            } else {
+                let sec = Section::from_spec(&b.section);
+                let ratio = (sec.area * b.length * b.length / sec.second_moment).sqrt();
+                format!(
+                    "axial stiffness EA is {:.0} x EJ/L^2: the beam is inextensible to that \
+                     ratio, and its axial modes lie far above its bending ones",
+                    ratio * ratio
+                )
+            },
+        ));
+        // quadratic-velocity terms: off when the beam's frame never rotates
+        let frame_still = b.substructures.is_none() && still.contains(&b.name);
+        o.quadratic_velocity = !frame_still;
+        why.push((
+            "quadratic_velocity",
+            n.clone(),
+            if frame_still {
+                "the beam is held to the world by welds or prismatic joints: its frame never \
+                 rotates, so the terms are zero"
+                    .into()
+            } else {
+                "the beam's frame rotates".into()
+            },
+        ));
+        // Rayleigh damping: off without coefficients
+        o.damping = b.rayleigh.alpha != 0.0 || b.rayleigh.beta != 0.0;
+        why.push((
+            "rayleigh_damping",
+            n.clone(),
+            if o.damping {
+                format!(
+                    "alpha = {}, beta = {}",
+                    b.rayleigh.alpha, b.rayleigh.beta
+                )
+            } else {
+                "no damping coefficients".into()
+            },
+        ));
+        // flexibility: a quasi-static response keeps a few modes
+        let (elements, k) = Scene::beam_layout(b);
+        let nodal = nodal_coordinates(b, elements, o.axial);
+        let flex_why = if b.rigid {
+            "the beam is rigid in the scene".to_string()
+        } else if b.initial.tip_displacement != 0.0 {
+            "the beam starts deformed: its free vibration is the point".into()
+        } else if o.modes.is_some() {
+            "modes asked for by the beam".into()
+        } else if w1 >= QUASI_STATIC_RATIO * bandwidth && nodal > AUTO_MODES {
+            o.modes = Some(AUTO_MODES);
+            format!(
+                "first bending frequency {w1:.3} rad/s is {} the excitation bandwidth \
+                 {bandwidth:.3} rad/s (set by {source}): the response is quasi-static, the \
+                 lowest {AUTO_MODES} modes of each frame carry it",
+                if bandwidth > 0.0 {
+                    format!("{:.0} x", w1 / bandwidth)
+                } else {
+                    "far above".into()
+                }
+            )
+        } else {
+            format!(
+                "the excitation ({source}) reaches the first bending frequency {w1:.3} rad/s{}",
+                if k > 1 {
+                    format!("; {k} substructures")
+                } else {
+                    String::new()
+                }
+            )
+        };
+        why.push(("flexibility", n.clone(), flex_why));
+        beams.push(BeamEffects {
+            rigid: b.rigid,
+            options: o,
+        });
+    }
+    let effects = Effects { gravity, beams };
+    finish(scene, "auto", effects, |effect, subject| {
+        why.iter()
+            .find(|(e, s, _)| *e == effect && s == subject)
+            .map(|(_, _, w)| w.clone())
+            .unwrap_or_default()
+    })
+}
+
+/// Deformation coordinates of one frame of beam `b` with `elements` elements.
+fn nodal_coordinates(b: &BeamSpec, elements: usize, axial: bool) -> usize {
+    let _ = b; // both frames (tangent, pinned) remove three nodal coordinates
+    let full = 3 * (elements + 1) - 3;
+    if axial {
+        full
+    } else {
+        full - elements // u of every node but the one the frame already removes
+    }
+}
+
+/// The decisions of resolved effects, with the cost of each one.
+fn finish(
+    scene: &Scene,
+    mode: &'static str,
+    effects: Effects,
+    why: impl Fn(&str, &str) -> String,
+) -> Resolution {
+    let total = step_cost(scene, &effects);
+    let share = |other: &Effects| ((total - step_cost(scene, other)) / total).abs();
+    let mut decisions = Vec::new();
+    let mut toggled = effects.clone();
+    toggled.gravity = !effects.gravity;
+    decisions.push(Decision {
+        effect: "gravity",
+        subject: "scene".into(),
+        setting: on_off(effects.gravity),
+        why: why("gravity", "scene"),
+        cost_share: if effects.gravity { share(&toggled) } else { 0.0 },
+    });
+    for (i, (b, e)) in scene.beams.iter().zip(&effects.beams).enumerate() {
+        let n = &b.name;
+        let (elements, k) = Scene::beam_layout(b);
+        let with = |f: &dyn Fn(&mut BeamEffects)| {
+            let mut other = effects.clone();
+            f(&mut other.beams[i]);
+            share(&other)
+        };
+        let setting = if e.rigid {
+            "rigid".to_string()
+        } else {
+            let layout = if k > 1 {
+                format!("{k} x {elements} elements")
+            } else {
+                format!("{elements} elements")
+            };
+            match e.options.modes {
+                Some(m) => format!("{layout}, {m} modes"),
+                None => layout,
+            }
+        };
+        decisions.push(Decision {
+            effect: "flexibility",
+            subject: n.clone(),
+            setting,
+            why: why("flexibility", n),
+            cost_share: if e.rigid {
+                0.0
+            } else {
+                with(&|x| x.rigid = true)
+            },
+        });
+        if e.rigid {
+            continue;
+        }
+        let o = e.options;
+        type Toggle = fn(&mut BeamOptions);
+        let rows: [(&'static str, bool, Toggle); 4] = [
+            ("axial", o.axial, |x| x.axial = !x.axial),
+            ("quadratic_velocity", o.quadratic_velocity, |x| {
+                x.quadratic_velocity = !x.quadratic_velocity
+            }),
+            ("geometric_stiffening", o.geometric_stiffening, |x| {
+                x.geometric_stiffening = !x.geometric_stiffening
+            }),
+            ("rayleigh_damping", o.damping, |x| x.damping = !x.damping),
+        ];
+        for (effect, on, toggle) in rows {
+            decisions.push(Decision {
+                effect,
+                subject: n.clone(),
+                setting: on_off(on),
+                why: why(effect, n),
+                cost_share: if on {
+                    with(&|x| toggle(&mut x.options))
+                } else {
+                    0.0
+                },
+            });
+        }
+    }
+    Resolution {
+        mode,
+        effects,
+        decisions,
+    }
+}
+
+fn on_off(on: bool) -> String {
+    if on { "on" } else { "off" }.into()
+}
+
+/// Number of coordinates of the resolved system.
+fn coordinates(scene: &Scene, effects: &Effects) -> usize {
+    frames(scene, effects).iter().map(|f| 3 + f.nf).sum::<usize>() + 3 * scene.bodies.len()
+}
+
+/// One floating frame of the resolved system, for the cost model.
+struct FrameCost {
+    nf: usize,
+    elements: usize,
+    options: BeamOptions,
+}
+
+fn frames(scene: &Scene, effects: &Effects) -> Vec<FrameCost> {
+    let mut out = Vec::new();
+    for (b, e) in scene.beams.iter().zip(&effects.beams) {
+        let (elements, k) = Scene::beam_layout(b);
+        let k = if e.rigid { 1 } else { k };
+        let nf = if e.rigid {
+            0
+        } else {
+            let nodal = nodal_coordinates(b, elements, e.options.axial);
+            e.options.modes.map_or(nodal, |m| m.min(nodal))
+        };
+        for _ in 0..k {
+            out.push(FrameCost {
+                nf,
+                elements,
+                options: e.options,
+            });
+        }
+    }
+    out
+}
+
+/// Operation count of one step with ≈ 3 Newton iterations: residuals and tangents of every
+/// frame, and one LU of the iteration matrix (n + m unknowns).
+fn step_cost(scene: &Scene, effects: &Effects) -> f64 {
+    let mut ops = 0.0;
+    let mut n = 3.0 * scene.bodies.len() as f64;
+    for f in frames(scene, effects) {
+        let nf = f.nf as f64;
+        n += 3.0 + nf;
+        if f.nf == 0 {
+            ops += 60.0; // a rigid body's residual and tangents
+            continue;
+        }
+        // residual (×3) and tangents (×1): mass coupling and stiffness are always there
+        let mut per = 4.0 * nf * nf + 20.0 * nf;
+        if f.options.quadratic_velocity {
+            per += 3.0 * nf * nf;
+        }
+        if f.options.damping {
+            per += 2.0 * nf * nf;
+        }
+        if f.options.geometric_stiffening {
+            per += f.elements as f64 * 4.0 * 6.0 * 6.0 * 4.0;
+            if f.options.modes.is_some() {
+                per += 2.0 * nf * nf * nf; // projection of the tangent
+            }
+        }
+        if effects.gravity {
+            per += 4.0 * nf;
+        }
+        ops += per;
+    }
+    if effects.gravity {
+        ops += 10.0 * scene.bodies.len() as f64;
+    }
+    // joints: ≈ 3 equations per joint
+    let m = 3.0 * (scene.joints.len() + scene.beams.len()) as f64;
+    ops + (n + m).powi(3) / 3.0
+}
