@@ -2,6 +2,7 @@
 //! system and the integrator state. The FMI layer (`fmi2/`) owns the call-sequence state
 //! machine and hands every request over to these methods.
 
+use crate::effects::Effects;
 use crate::error::EngineError;
 use crate::integrator::{self, GaState, Settings, Stats, Stepper};
 use crate::multibody::law::InputValue;
@@ -39,6 +40,9 @@ pub struct Snapshot {
 #[derive(Debug, Clone)]
 pub struct Engine {
     scene: Scene,
+    /// The effects resolved from the scene as packaged; parameter values set later change
+    /// the model's numbers, not which terms it computes (nor its variables).
+    effects: Effects,
     table: VariableTable,
     /// Current value of every parameter and input, indexed by value reference (outputs unused).
     values: Vec<f64>,
@@ -58,7 +62,8 @@ const STATE_VERSION: u32 = 1;
 
 impl Engine {
     pub fn new(scene: Scene) -> Engine {
-        let table = VariableTable::build(&scene);
+        let effects = crate::effects::resolve(&scene).effects;
+        let table = VariableTable::build_with(&scene, &effects);
         let values: Vec<f64> = table
             .variables
             .iter()
@@ -69,6 +74,7 @@ impl Engine {
             warned: vec![false; scene.beams.len()],
             messages: Vec::new(),
             scene,
+            effects,
             table,
             values,
             initialized: false,
@@ -289,7 +295,7 @@ impl Engine {
         if self.model.is_none() {
             let scene = self.scene_with(&self.values);
             scene.validate("parameters")?;
-            let system = System::from_scene(&scene);
+            let system = System::build(&scene, &self.effects);
             let settings = Settings::from_scene(&scene);
             let mut system = system;
             for (i, var) in self.table.variables.iter().enumerate() {

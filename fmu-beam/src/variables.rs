@@ -1,6 +1,7 @@
 //! The variable table of a scene: the single source of the engine's get/set and of the
 //! ModelVariables, UnitDefinitions and ModelStructure that the packager writes.
 
+use crate::effects::Effects;
 use crate::scene::Scene;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -202,7 +203,15 @@ pub struct VariableTable {
 }
 
 impl VariableTable {
+    /// The table of a scene with the effects it resolves to.
     pub fn build(scene: &Scene) -> VariableTable {
+        VariableTable::build_with(scene, &crate::effects::resolve(scene).effects)
+    }
+
+    /// The table of a scene computing `effects`: only the variables of effects that are on
+    /// (no gravity parameters without gravity, no stiffness, damping or deflection of a rigid
+    /// beam, no damping parameters without damping).
+    pub fn build_with(scene: &Scene, effects: &Effects) -> VariableTable {
         let mut t = Builder { vars: Vec::new() };
         use Binding::{Output as O, Parameter as P};
         use Causality as C;
@@ -222,24 +231,26 @@ impl VariableTable {
             );
         };
         let g = scene.world.gravity;
-        real_param(
-            &mut t,
-            "world.gravity.x".into(),
-            T::GravityX,
-            "m/s2",
-            g[0],
-            V::Fixed,
-            "Gravity, world x",
-        );
-        real_param(
-            &mut t,
-            "world.gravity.y".into(),
-            T::GravityY,
-            "m/s2",
-            g[1],
-            V::Fixed,
-            "Gravity, world y",
-        );
+        if effects.gravity {
+            real_param(
+                &mut t,
+                "world.gravity.x".into(),
+                T::GravityX,
+                "m/s2",
+                g[0],
+                V::Fixed,
+                "Gravity, world x",
+            );
+            real_param(
+                &mut t,
+                "world.gravity.y".into(),
+                T::GravityY,
+                "m/s2",
+                g[1],
+                V::Fixed,
+                "Gravity, world y",
+            );
+        }
         let s = &scene.solver;
         t.push(
             "solver.adaptive".into(),
@@ -278,7 +289,7 @@ impl VariableTable {
             V::Tunable,
             "Generalized-alpha spectral radius at infinity (1: no numerical damping)",
         );
-        for (i, b) in scene.beams.iter().enumerate() {
+        for (i, (b, fx)) in scene.beams.iter().zip(&effects.beams).enumerate() {
             let n = &b.name;
             real_param(
                 &mut t,
@@ -298,15 +309,17 @@ impl VariableTable {
                 V::Fixed,
                 "Density",
             );
-            real_param(
-                &mut t,
-                format!("{n}.E"),
-                T::BeamE(i),
-                "Pa",
-                b.material.e,
-                V::Fixed,
-                "Young's modulus",
-            );
+            if !fx.rigid {
+                real_param(
+                    &mut t,
+                    format!("{n}.E"),
+                    T::BeamE(i),
+                    "Pa",
+                    b.material.e,
+                    V::Fixed,
+                    "Young's modulus",
+                );
+            }
             if b.section.shape.is_none() {
                 real_param(
                     &mut t,
@@ -348,24 +361,29 @@ impl VariableTable {
                     O(K::SectionSecondMoment(i)),
                 );
             }
-            real_param(
-                &mut t,
-                format!("{n}.rayleigh.alpha"),
-                T::BeamRayleighAlpha(i),
-                "1/s",
-                b.rayleigh.alpha,
-                V::Fixed,
-                "Rayleigh damping, mass-proportional",
-            );
-            real_param(
-                &mut t,
-                format!("{n}.rayleigh.beta"),
-                T::BeamRayleighBeta(i),
-                "s",
-                b.rayleigh.beta,
-                V::Fixed,
-                "Rayleigh damping, stiffness-proportional",
-            );
+            if fx.rigid {
+                continue;
+            }
+            if fx.options.damping {
+                real_param(
+                    &mut t,
+                    format!("{n}.rayleigh.alpha"),
+                    T::BeamRayleighAlpha(i),
+                    "1/s",
+                    b.rayleigh.alpha,
+                    V::Fixed,
+                    "Rayleigh damping, mass-proportional",
+                );
+                real_param(
+                    &mut t,
+                    format!("{n}.rayleigh.beta"),
+                    T::BeamRayleighBeta(i),
+                    "s",
+                    b.rayleigh.beta,
+                    V::Fixed,
+                    "Rayleigh damping, stiffness-proportional",
+                );
+            }
             real_param(
                 &mut t,
                 format!("{n}.initial.tip_displacement"),
@@ -459,8 +477,11 @@ impl VariableTable {
                 Binding::Input(slot),
             );
         }
-        for (i, b) in scene.beams.iter().enumerate() {
+        for (i, (b, fx)) in scene.beams.iter().zip(&effects.beams).enumerate() {
             for o in Scene::beam_outputs(b) {
+                if fx.rigid && o.ends_with("deflection") {
+                    continue; // a rigid beam does not deflect
+                }
                 let (kind, unit, desc) = match o {
                     "tip.deflection" => (
                         K::TipDeflection(i),
@@ -567,6 +588,10 @@ impl VariableTable {
                 "Kinetic + strain + potential energy",
             ),
         ] {
+            let strain = kind == K::EnergyStrain && effects.beams.iter().all(|b| b.rigid);
+            if strain || (kind == K::EnergyPotential && !effects.gravity) {
+                continue; // no deformation, or no gravity field
+            }
             t.output(name.into(), VarType::Real, Some("J"), desc, kind);
         }
         t.output(

@@ -1,4 +1,4 @@
-//! The command line: `package`, `modes`, `work-precision`, `simulate` and `cosim`.
+//! The command line: `package`, `explain`, `modes`, `work-precision`, `simulate` and `cosim`.
 
 use crate::error::HarnessError;
 use crate::{cosim, modes, package, simulate, work_precision};
@@ -30,6 +30,12 @@ pub enum Command {
         /// executable's target directory, else the one beside this executable].
         #[arg(long)]
         binary: Option<PathBuf>,
+    },
+    /// Print the effects the scene's unit simulates, why, and their estimated share of the
+    /// cost (the text the FMU carries in documentation/).
+    Explain {
+        /// The scene file (TOML).
+        scene: PathBuf,
     },
     /// Print the scene's linearized natural frequencies in Hz (rigid-body modes left out).
     Modes {
@@ -180,6 +186,11 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                     eprint!("{}", summary.text());
                 }
             }
+        }
+        Command::Explain { scene } => {
+            let scene = fmu_beam::Scene::load(&scene)?;
+            let text = fmu_beam::effects::resolve(&scene).explain(&scene);
+            out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
         Command::Modes { scene, count } => {
             let f = modes::elastic_frequencies(&scene)?;

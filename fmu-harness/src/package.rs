@@ -35,6 +35,8 @@ pub struct FmuContents {
     pub guid: String,
     pub model_description: String,
     pub scene_text: String,
+    /// documentation/index.html: the resolved effects and why (`fmu-harness explain`).
+    pub documentation: String,
     pub variables: usize,
 }
 
@@ -50,8 +52,27 @@ pub fn contents(scene: &Scene, binary: &[u8]) -> Result<FmuContents, HarnessErro
         guid,
         model_description,
         scene_text,
+        documentation: documentation(scene),
         variables: table.variables.len(),
     })
+}
+
+/// documentation/index.html: the scene's description and its resolved effects.
+fn documentation(scene: &Scene) -> String {
+    let escape = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let effects = fmu_beam::effects::resolve(scene).explain(scene);
+    format!(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head>\n\
+         <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Effects</h2>\n<pre>\n{effects}</pre>\n\
+         </body></html>\n",
+        name = escape(&scene.name),
+        description = escape(&scene.description),
+        effects = escape(&effects),
+    )
 }
 
 /// The scene text the engine will read, checked to read back as the same scene.
@@ -104,6 +125,11 @@ pub fn package(
             Entry {
                 path: "resources/guid.txt",
                 data: c.guid.as_bytes(),
+                mode: 0o644,
+            },
+            Entry {
+                path: "documentation/index.html",
+                data: c.documentation.as_bytes(),
                 mode: 0o644,
             },
         ],

@@ -54,8 +54,15 @@ fn archive_holds_the_fmi_layout_with_fixed_metadata() {
             "modelDescription.xml",
             "binaries/linux64/cantilever_free_vibration.so",
             "resources/scene.toml",
-            "resources/guid.txt"
+            "resources/guid.txt",
+            "documentation/index.html"
         ]
+    );
+    // the documentation is the explanation of the resolved effects
+    let doc = read_entry(&out, "documentation/index.html");
+    assert!(
+        doc.contains("quadratic_velocity (beam)") && doc.contains("effects = all"),
+        "{doc}"
     );
     for i in 0..z.len() {
         let f = z.by_index(i).unwrap();

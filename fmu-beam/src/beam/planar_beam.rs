@@ -709,8 +709,7 @@ impl PlanarBeam {
         for j in 0..self.elements {
             let idx: [Option<usize>; ELEMENT_DOFS] =
                 std::array::from_fn(|p| self.flex_index(3 * j + p));
-            let qe: [f64; ELEMENT_DOFS] =
-                std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
+            let qe: [f64; ELEMENT_DOFS] = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
             let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
             let mut de = da;
             let mut hv = [[0.0; ELEMENT_DOFS]; ELEMENT_DOFS];

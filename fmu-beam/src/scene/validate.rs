@@ -261,7 +261,11 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
             ));
         }
         if names[..k].contains(n) {
-            return Err(ck.fail(&format!("effects[{k}]"), format!("{n:?}"), "is listed twice"));
+            return Err(ck.fail(
+                &format!("effects[{k}]"),
+                format!("{n:?}"),
+                "is listed twice",
+            ));
         }
     }
     let on = |e: &str| names.iter().any(|n| n == e);
