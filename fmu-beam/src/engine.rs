@@ -290,11 +290,47 @@ impl Engine {
         s
     }
 
+    /// With `effects = "auto"`, the effects were chosen for the packaged parameter values; if
+    /// the values set now would make `auto` choose others (a faster spin that needs geometric
+    /// stiffening, say), the unit still computes the packaged ones: say so.
+    fn warn_if_auto_would_differ(&mut self, scene: &Scene) {
+        if scene.effects != crate::scene::EffectsSpec::Mode("auto".into()) {
+            return;
+        }
+        let now = crate::effects::resolve(scene);
+        if now.effects == self.effects {
+            return;
+        }
+        let packaged = crate::effects::resolve(&self.scene);
+        let changed: Vec<String> = now
+            .decisions
+            .iter()
+            .filter(|d| {
+                !packaged.decisions.iter().any(|p| {
+                    p.effect == d.effect && p.subject == d.subject && p.setting == d.setting
+                })
+            })
+            .map(|d| {
+                format!(
+                    "{} ({}) would be {}: {}",
+                    d.effect, d.subject, d.setting, d.why
+                )
+            })
+            .collect();
+        self.messages.push(format!(
+            "effects = \"auto\" was resolved for the packaged parameter values; with the values \
+             set now it would choose otherwise, and the unit keeps the packaged effects. \
+             Re-package the scene with these values to let auto decide again. {}",
+            changed.join("; ")
+        ));
+    }
+
     /// The model for the current parameters, built on first need.
     fn built(&mut self) -> Result<&mut Model, EngineError> {
         if self.model.is_none() {
             let scene = self.scene_with(&self.values);
             scene.validate("parameters")?;
+            self.warn_if_auto_would_differ(&scene);
             let system = System::build(&scene, &self.effects);
             let settings = Settings::from_scene(&scene);
             let mut system = system;

@@ -349,3 +349,27 @@ fn the_variables_are_those_of_the_effects_that_are_on() {
     }
     assert!(has(&rigid, "crank.tip.x") && has(&rigid, "rod.E"));
 }
+
+#[test]
+fn auto_warns_when_parameters_would_change_its_choice() {
+    use fmu_beam::Engine;
+    // C4 single frame spun to 0.5 rad/s: auto needs no stiffening; at 10 rad/s it would
+    let mut s = auto("spin_up_omega10_single_frame.toml");
+    s.joints[0].drive.as_mut().unwrap().law.omega = Some(0.5);
+    assert!(!resolve(&s).effects.beams[0].options.geometric_stiffening);
+    let mut e = Engine::new(s.clone());
+    let omega = common::vr(&e, "hub.drive.omega");
+    e.set_real(omega, 10.0).unwrap();
+    e.exit_initialization().unwrap();
+    let warnings = e.take_messages();
+    assert!(
+        warnings
+            .iter()
+            .any(|m| m.contains("geometric_stiffening (beam) would be on")),
+        "{warnings:?}"
+    );
+    // the packaged value raises no warning
+    let mut e = Engine::new(s);
+    e.exit_initialization().unwrap();
+    assert!(e.take_messages().is_empty());
+}
