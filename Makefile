@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools release fmus demo test check bench example-arm example-sweep clean distclean
+.PHONY: .venv tools release fmus demo test check bench example-split example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -62,6 +62,13 @@ bench: .venv fmus
 	$(PY) tests/bench_c1.py
 	$(HARNESS) work-precision --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/work_precision.csv
+
+# The split slider-crank (examples/split_slider_crank): cosim, the fmpy script, the step study.
+example-split: .venv fmus
+	mkdir -p build/split
+	$(HARNESS) cosim examples/split_slider_crank/system.toml -o build/split/cosim.csv
+	$(PY) examples/split_slider_crank/cosim_fmpy.py -o build/split/fmpy.csv
+	$(PY) examples/split_slider_crank/study.py
 
 # The examples (examples/README.md): the flexible arm under PID control (fmpy script) and the
 # C4 parameter sweep on Dask (a local cluster of 2 workers; see examples/sweep.py --help).

@@ -30,7 +30,7 @@ use crate::simulate::Results;
 use crate::slave::{Causality, Slave, SlaveError, VarType, Variable};
 use extrapolation::History;
 use std::path::{Path, PathBuf};
-use system::{Algorithm, Extrapolation, StartValue, System, SystemError};
+use system::{Algorithm, StartValue, System, SystemError};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -140,6 +140,8 @@ struct Link {
     to_unit: usize,
     to_vr: u32,
     factor: f64,
+    /// Degree of the input polynomial (0 held, 1 linear, 2 quadratic).
+    order: usize,
     history: History,
     /// The value at the end of the current attempt, once its source has stepped.
     fresh: Option<f64>,
@@ -322,6 +324,7 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
             to_unit: tu,
             to_vr: tv.value_reference,
             factor: c.factor,
+            order: c.extrapolation.unwrap_or(system.extrapolation).order(),
             history: History::default(),
             fresh: None,
         });
@@ -382,7 +385,6 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
         Algorithm::Jacobi => (0..units.len()).collect(),
         Algorithm::GaussSeidel => system.stepping_order(),
     };
-    let p = system.extrapolation.order();
     let variable_step = system.step.variable;
     let stop = system.stop_time;
     let mut summary = Summary {
@@ -425,7 +427,6 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
                 &mut links,
                 &order,
                 system.algorithm,
-                system.extrapolation,
                 &checks,
                 t,
                 h_try,
@@ -471,20 +472,24 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
                 break (h_try, h);
             };
             // Coupling error estimate against the extrapolation from before t + h.
-            let p = links.first().map_or(p, |l| p.min(l.history.len() - 1));
-            let e = links
+            // Each signal's factor 0.9·E_l^(−1/(p_l+1)), the smallest wins.
+            let (e, factor) = links
                 .iter()
                 .map(|l| {
+                    let p = l.order.min(l.history.len() - 1);
                     let y = l.fresh.unwrap_or(0.0);
                     let pred = l.history.predict(p, t + h_try);
-                    (y - pred).abs() / (v.abs_tolerance + v.tolerance * y.abs())
+                    let e = (y - pred).abs() / (v.abs_tolerance + v.tolerance * y.abs());
+                    let f = if e > 0.0 {
+                        (0.9 * e.powf(-1.0 / (p as f64 + 1.0))).clamp(0.2, 5.0)
+                    } else {
+                        5.0
+                    };
+                    (e, f)
                 })
-                .fold(0.0, f64::max);
-            let factor = if e > 0.0 {
-                (0.9 * e.powf(-1.0 / (p as f64 + 1.0))).clamp(0.2, 5.0)
-            } else {
-                5.0
-            };
+                .fold((0.0_f64, 5.0_f64), |(e0, f0), (e, f)| {
+                    (e0.max(e), f0.min(f))
+                });
             let proposal = (h_try * factor).clamp(v.min, v.max);
             if e > 1.0 && rollback.is_some() && h_try > v.min * (1.0 + 1e-12) {
                 restore(&mut units)?;
@@ -546,20 +551,19 @@ fn attempt(
     links: &mut [Link],
     order: &[usize],
     algorithm: Algorithm,
-    extrapolation: Extrapolation,
     checks: &[Check],
     t: f64,
     h: f64,
 ) -> Result<Option<Refused>, CosimError> {
-    let p = extrapolation.order();
     for l in links.iter_mut() {
         l.fresh = None;
     }
     for &k in order {
-        let interpolates = units[k].interpolates && p > 0;
         let (mut vrs, mut values, mut der_vrs, mut orders, mut ders) =
             (vec![], vec![], vec![], vec![], vec![]);
         for l in links.iter().filter(|l| l.to_unit == k) {
+            let p = l.order;
+            let interpolates = units[k].interpolates && p > 0;
             let fresh = l.fresh.filter(|_| algorithm == Algorithm::GaussSeidel);
             let (value, d) = match (fresh, interpolates) {
                 (Some(y), false) => (y, [0.0; 2]),

@@ -155,12 +155,14 @@ pub enum StartValue {
     Real(f64),
 }
 
-/// `"a.x -> b.u"`, or `{ from = "a.x", to = "b.u", factor = -1.0 }` (u = factor·x).
+/// `"a.x -> b.u"`, or `{ from = "a.x", to = "b.u", factor = -1.0, extrapolation = "none" }`
+/// (u = factor·x; `extrapolation` overrides the system's for this connection).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConnectionSpec {
     pub from: String,
     pub to: String,
     pub factor: f64,
+    pub extrapolation: Option<Extrapolation>,
 }
 
 #[derive(Deserialize)]
@@ -170,6 +172,8 @@ struct ConnectionTable {
     to: String,
     #[serde(default = "one")]
     factor: f64,
+    #[serde(default)]
+    extrapolation: Option<Extrapolation>,
 }
 
 fn one() -> f64 {
@@ -194,6 +198,7 @@ impl<'de> Deserialize<'de> for ConnectionSpec {
                     from: from.trim().to_string(),
                     to: to.trim().to_string(),
                     factor: 1.0,
+                    extrapolation: None,
                 })
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ConnectionSpec, A::Error> {
@@ -202,6 +207,7 @@ impl<'de> Deserialize<'de> for ConnectionSpec {
                     from: t.from,
                     to: t.to,
                     factor: t.factor,
+                    extrapolation: t.extrapolation,
                 })
             }
         }
@@ -391,7 +397,7 @@ step = { size = 1e-2 }
 algorithm = "gauss-seidel"
 order = ["b", "a"]
 extrapolation = "linear"
-connections = ["a.x -> b.u", { from = "b.y", to = "a.u", factor = -1.0 }]
+connections = ["a.x -> b.u", { from = "b.y", to = "a.u", factor = -1.0, extrapolation = "none" }]
 [[unit]]
 name = "a"
 fmu = "a.fmu"
@@ -419,6 +425,8 @@ check = [{ variable = "a.e", max = 1.0 }]
             (s.connections[1].from.as_str(), s.connections[1].factor),
             ("b.y", -1.0)
         );
+        assert_eq!(s.connections[1].extrapolation, Some(Extrapolation::None));
+        assert_eq!(s.connections[0].extrapolation, None);
         assert_eq!(s.units[0].start["k"], StartValue::Real(2.0));
         assert_eq!(s.units[0].start["n"], StartValue::Integer(3));
         assert_eq!(s.rollback.as_ref().unwrap().max_halvings, 4);
