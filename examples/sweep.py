@@ -20,6 +20,7 @@ import argparse
 import csv
 import hashlib
 import io
+import os
 import statistics
 import sys
 import tempfile
@@ -162,7 +163,8 @@ def plot(results, path):
 
 def benchmark(fmu_bytes, points, stop, step, per_task, runs):
     """Wall time of the whole sweep on warm LocalClusters of 1 and 2 workers (cluster start-up
-    excluded), `runs` times each, interleaved; returns {workers: [seconds]}."""
+    excluded), `runs` times each, interleaved; returns {workers: [seconds]}. Prints the 1-minute
+    load average after each run: other processes on the machine slow the runs down."""
     clients = {w: local_client(w) for w in (1, 2)}
     times = {w: [] for w in clients}
     try:
@@ -173,7 +175,8 @@ def benchmark(fmu_bytes, points, stop, step, per_task, runs):
                 start = time.perf_counter()
                 sweep_dask(c, fmu_bytes, points, stop, step, per_task, progress=lambda _: None)
                 times[w].append(time.perf_counter() - start)
-                print(f"run {run + 1}/{runs}, {w} worker(s): {times[w][-1]:.2f} s", flush=True)
+                print(f"run {run + 1}/{runs}, {w} worker(s): {times[w][-1]:.2f} s "
+                      f"(load average {os.getloadavg()[0]:.2f})", flush=True)
     finally:
         for c in clients.values():
             cluster = c.cluster
