@@ -20,6 +20,7 @@ import argparse
 import csv
 import hashlib
 import io
+import logging
 import os
 import statistics
 import sys
@@ -128,7 +129,8 @@ def local_client(workers):
     """A LocalCluster of `workers` single-threaded worker processes and its client."""
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           silence_logs=logging.ERROR)
     return Client(cluster)
 
 
