@@ -1,14 +1,16 @@
 """A second FMI master (issue 6): case C2 (scenes/flexible_pendulum.toml) run by libcosim (the Open
 Simulation Platform's co-simulation library, through libcosimpy) and by fmpy's FMU2Slave with the
 same fixed communication steps gives the same outputs at every communication point, within 1e-9
-relative to the output's largest magnitude over the run (measured: bit for bit).
+relative (to the value, or to 1e-3 of the output's largest magnitude for entries near zero);
+measured: bit for bit.
 
 Both masters make the same calls (setup, initialization, doStep from t to t + h) and the engine is
 deterministic. "The same steps" must mean the same doubles: libcosim counts time in integer
 nanoseconds, and fmpy's usual t = k h differs from its t by an ulp now and then. With error control
-(the scene's default) such an ulp can flip one accept/reject decision of the step-size controller,
-after which the runs differ at the level of the tolerance (C2, 1e-3 s steps: from step 12 on, up
-to 4e-4 of the peak tip deflection over 0.5 s). So fmpy is driven here at libcosim's communication
+(the scene's default) such an ulp can change a decision of the step-size controller, after which
+the runs differ at the level of the tolerance (C2, 1e-3 s steps: the internal step counts part at
+the 12th communication step, 87 against 86, and the outputs then differ by up to 4e-4 of the peak
+tip deflection over 0.5 s). So fmpy is driven here at libcosim's communication
 points. A run of fmpy at a different communication step disagrees by far more than the bound: the
 comparison can tell."""
 
@@ -86,8 +88,10 @@ def run_fmpy(path, md, vrs, step_ns, steps, tmp_path):
 
 
 def relative_difference(a, b):
-    """Per output, the largest |a - b| over the run relative to the largest |b| over the run."""
-    return np.max(np.abs(a - b), axis=0) / np.max(np.abs(b), axis=0)
+    """Per output, the largest |a - b| over the run relative to the values themselves, or to
+    1e-3 of the output's largest magnitude over the run for entries near zero."""
+    floor = 1e-3 * np.max(np.abs(b), axis=0)
+    return np.max(np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), floor), axis=0)
 
 
 def test_libcosim_equals_fmpy_on_c2(pendulum, tmp_path):
