@@ -42,19 +42,18 @@ COLUMNS = ["omega", "E", "tip_deflection_max", "tip_deflection_end", "tip_radius
 # farther tip means a stretched beam, a model used beyond its (small-strain) validity.
 STRETCH = 0.01
 
-# FMU bytes unpacked in this (worker) process, by content hash: unzipped once, reused by every task
-_unpacked = {}
-
-
 def unpack(fmu_bytes):
-    """The directory where this process has unpacked the FMU (once per content)."""
-    key = hashlib.sha256(fmu_bytes).hexdigest()
-    if key not in _unpacked:
-        directory = tempfile.mkdtemp(prefix=f"sweep_{key[:12]}_")
+    """The directory where this process has unpacked the FMU: unzipped on first use, found again
+    by later tasks in the same worker process (named by content hash and process id, so that it
+    works whether Dask ships this function by reference or by value)."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()[:16]
+    directory = Path(tempfile.gettempdir()) / f"fmu_sweep_{key}_{os.getpid()}"
+    if not directory.is_dir():
+        partial = Path(tempfile.mkdtemp(prefix=directory.name + "_", dir=directory.parent))
         with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
-            z.extractall(directory)
-        _unpacked[key] = directory
-    return _unpacked[key]
+            z.extractall(partial)
+        os.replace(partial, directory)  # whole or not at all
+    return str(directory)
 
 
 def run_chunk(fmu_bytes, points, stop, step):
