@@ -22,6 +22,7 @@ import hashlib
 import io
 import logging
 import os
+import shutil
 import statistics
 import sys
 import tempfile
@@ -42,12 +43,17 @@ COLUMNS = ["omega", "E", "tip_deflection_max", "tip_deflection_end", "tip_radius
 # farther tip means a stretched beam, a model used beyond its (small-strain) validity.
 STRETCH = 0.01
 
-def unpack(fmu_bytes):
-    """The directory where this process has unpacked the FMU: unzipped on first use, found again
-    by later tasks in the same worker process (named by content hash and process id, so that it
-    works whether Dask ships this function by reference or by value)."""
+def unpacked_directory(fmu_bytes):
+    """Where this process unpacks the FMU: named by content hash and process id, so that later
+    tasks in the same worker process find it, whether Dask ships the task's function by
+    reference or by value."""
     key = hashlib.sha256(fmu_bytes).hexdigest()[:16]
-    directory = Path(tempfile.gettempdir()) / f"fmu_sweep_{key}_{os.getpid()}"
+    return Path(tempfile.gettempdir()) / f"fmu_sweep_{key}_{os.getpid()}"
+
+
+def unpack(fmu_bytes):
+    """The directory where this process has unpacked the FMU, unzipped on first use."""
+    directory = unpacked_directory(fmu_bytes)
     if not directory.is_dir():
         partial = Path(tempfile.mkdtemp(prefix=directory.name + "_", dir=directory.parent))
         with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
@@ -93,6 +99,23 @@ def run_chunk(fmu_bytes, points, stop, step):
         fmu.freeInstance()
         fmu.freeLibrary()
     return results
+
+
+def remove_unpacked(fmu_bytes):
+    """Removes this process's unpacked copy of the FMU (run on each worker before closing)."""
+    shutil.rmtree(unpacked_directory(fmu_bytes), ignore_errors=True)
+
+
+def close(client, fmu_bytes, cluster=None):
+    """Removes the unpacked FMUs of the client's workers and of this process, closes the client
+    and, if given, the cluster."""
+    try:
+        client.run(remove_unpacked, fmu_bytes)
+    finally:
+        remove_unpacked(fmu_bytes)
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def grid(omegas=OMEGAS, e_factors=E_FACTORS):
@@ -180,9 +203,7 @@ def benchmark(fmu_bytes, points, stop, step, per_task, runs):
                       f"(load average {os.getloadavg()[0]:.2f})", flush=True)
     finally:
         for c in clients.values():
-            cluster = c.cluster
-            c.close()
-            cluster.close()
+            close(c, fmu_bytes, c.cluster)
     return times
 
 
@@ -218,6 +239,7 @@ def main(argv=None):
           f"{a.per_task} per task", flush=True)
     if a.workers == 0 and not a.scheduler:
         results = sweep_serial(fmu_bytes, points, a.stop, a.step, a.per_task)
+        remove_unpacked(fmu_bytes)
     else:
         from distributed import Client
 
@@ -227,10 +249,7 @@ def main(argv=None):
             results = sweep_dask(client, fmu_bytes, points, a.stop, a.step, a.per_task,
                                  progress=lambda s: print(s, flush=True))
         finally:
-            cluster = client.cluster if not a.scheduler else None
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            close(client, fmu_bytes, None if a.scheduler else client.cluster)
     for r in results:
         if r["tip_radius_max"] > (1 + STRETCH) * LENGTH:
             print(f"warning: Omega = {r['omega']}, E = {r['E']:.4g}: the tip reached "

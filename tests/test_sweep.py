@@ -41,13 +41,14 @@ def test_two_dask_workers_equal_the_serial_run(sweep, fmu_bytes):
         progress = []
         parallel = sweep.sweep_dask(client, fmu_bytes, points, STOP, STEP, per_task=2, progress=progress.append)
     finally:
-        cluster = client.cluster
-        client.close()
-        cluster.close()
+        sweep.close(client, fmu_bytes, client.cluster)
     assert len(progress) == 2 and "4/4 points" in progress[-1]
 
-    serial = sweep.run_chunk(fmu_bytes, list(reversed(points)), STOP, STEP)[::-1]
-    fresh = sweep.run_chunk(fmu_bytes, points[:1], STOP, STEP)
+    try:
+        serial = sweep.run_chunk(fmu_bytes, list(reversed(points)), STOP, STEP)[::-1]
+        fresh = sweep.run_chunk(fmu_bytes, points[:1], STOP, STEP)
+    finally:
+        sweep.remove_unpacked(fmu_bytes)
     assert [(r["omega"], r["E"]) for r in parallel] == points
     assert parallel == serial
     assert parallel[0] == fresh[0]
