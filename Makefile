@@ -58,10 +58,12 @@ check:
 	cargo clippy --workspace --all-targets -- -D warnings
 	$(MAKE) test
 
-bench: .venv fmus
-	$(PY) tests/bench_c1.py
+# Work-precision study (fmu-harness work-precision): every case C1-C4 over formulations, integrator
+# settings and effects; build/bench/REPORT.md, points.csv, <case>.png, and the README's chart.
+# (tests/bench_c1.py, C1 timed through fmpy, runs by hand: $(PY) tests/bench_c1.py)
+bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench
-	$(PY) tests/plot_work_precision.py build/bench/work_precision.csv
+	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
 
 # The split slider-crank (examples/split_slider_crank): cosim, the fmpy script, the step study.
 example-split: .venv fmus

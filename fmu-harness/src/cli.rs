@@ -73,8 +73,10 @@ pub enum Command {
         #[arg(short = 'o', long = "csv")]
         csv: Option<PathBuf>,
     },
-    /// Work-precision study of the validation cases (error against a tight-tolerance reference
-    /// versus time, over the integrator tolerance); writes work_precision.csv and .md.
+    /// Work-precision study of the validation cases C1–C4: every formulation (elements,
+    /// substructures, rigid parts, modal truncation, stiffening) at every integrator setting
+    /// against one reference per case, then each effect switched off in turn; writes
+    /// points.csv and REPORT.md.
     WorkPrecision {
         /// Directory of the scene files.
         #[arg(long, default_value = "scenes")]
@@ -85,16 +87,11 @@ pub enum Command {
         /// Timed runs per point (median, min and max are reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
-        /// Tolerances of the error control to sweep.
-        #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8])]
-        tolerances: Vec<f64>,
-        /// Fixed internal steps (s) to sweep.
-        #[arg(long, value_delimiter = ',', default_values_t = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4])]
-        steps: Vec<f64>,
-        /// Tolerance of the reference run.
-        #[arg(long, default_value_t = 1e-9)]
-        reference: f64,
-        /// Only these cases (C1, C2, C2-tip, C3, C3-rigid-crank, C4-omega10, ...).
+        /// CPU seconds of one run above which the tighter settings of the same formulation
+        /// and integrator mode are skipped.
+        #[arg(long, default_value_t = 2.5)]
+        budget: f64,
+        /// Only these cases (C1, C2, C3, C4).
         #[arg(long, value_delimiter = ',')]
         cases: Vec<String>,
     },
@@ -125,30 +122,19 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             scenes,
             output,
             repeats,
-            tolerances,
-            steps,
-            reference,
+            budget,
             cases,
         } => {
-            let settings: Vec<_> = tolerances
-                .iter()
-                .map(|&t| work_precision::Setting::Tolerance(t))
-                .chain(steps.iter().map(|&h| work_precision::Setting::FixedStep(h)))
-                .collect();
-            let chosen: Vec<_> = work_precision::CASES
-                .iter()
+            let chosen: Vec<_> = work_precision::cases::cases()
+                .into_iter()
                 .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
-                .cloned()
                 .collect();
-            let points = work_precision::study(
-                &scenes,
-                &chosen,
-                &settings,
-                repeats,
-                reference,
-                &mut |line| eprintln!("{line}"),
-            )?;
-            for path in work_precision::write(&output, &points)? {
+            let options = work_precision::Options { repeats, budget };
+            let started = std::time::Instant::now();
+            let results =
+                work_precision::study(&scenes, &chosen, &options, &mut |line| eprintln!("{line}"))?;
+            let header = work_precision::header(&options, started.elapsed().as_secs_f64());
+            for path in work_precision::report::write(&output, &results, &header)? {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
             }
         }
