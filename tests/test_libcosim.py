@@ -19,11 +19,10 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-cosim = pytest.importorskip("libcosimpy.CosimExecution", reason="libcosimpy is in requirements.txt")
-from libcosimpy.CosimExecution import CosimExecution  # noqa: E402
-from libcosimpy.CosimLogging import CosimLogLevel, log_output_level  # noqa: E402
-from libcosimpy.CosimObserver import CosimObserver  # noqa: E402
-from libcosimpy.CosimSlave import CosimLocalSlave  # noqa: E402
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimObserver import CosimObserver
+from libcosimpy.CosimSlave import CosimLocalSlave
 
 SCENE = "flexible_pendulum"
 OUTPUTS = ["beam.tip.deflection", "beam.tip.x", "beam.tip.y", "beam.mid.deflection", "hinge.angle",
