@@ -659,7 +659,7 @@ pub fn header(options: &Options, wall_seconds: f64) -> String {
          `tests/plot_work_precision.py`) in {:.0} s wall time on {cores} cores ({cpu}). \
          CPU time is the thread's own account from the Linux scheduler (`/proc/thread-self/\
          schedstat`), so other load on the machine changes it little; each point is the median \
-         (min–max) of {} runs of the engine itself (no FMI layer, no output recording beyond the \
+         (min–max) of {} timed samples of the engine itself (no FMI layer, no output recording beyond the \
          compared outputs). A run whose median exceeds {} s ends the sweep of tighter settings of \
          its formulation and integrator mode (marked skipped). Fixed-step runs stop Newton at \
          {FIXED_STEP_NEWTON_TOLERANCE:.0e}; error-control runs use the tolerance for both and may \
