@@ -58,6 +58,8 @@ pub struct Engine {
 }
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
+/// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
+const STRETCH_LIMIT: f64 = 0.01;
 const STATE_VERSION: u32 = 1;
 
 impl Engine {
@@ -440,31 +442,44 @@ impl Engine {
     /// above its first bending frequency) and the step is refused.
     fn monitor_validity(&mut self) -> Result<(), EngineError> {
         let m = self.model.as_ref().expect("model built");
-        let sys = &m.system;
+        let (sys, q, t) = (&m.system, &m.state.q, m.state.t);
         for (g, grp) in sys.beams.iter().enumerate() {
-            if grp.bodies.len() != 1 || sys.beam(grp.bodies.start).is_none() {
-                continue;
-            }
-            let (tip, _) = sys.beam_tip(g, &m.state.q);
-            let defl = sys.beam_transverse(g, &m.state.q, tip).abs();
-            let t = m.state.t;
-            if defl > grp.length || !defl.is_finite() {
-                return Err(EngineError::Runaway {
+            // a beam does not stretch: a chord longer than the beam is a model out of range
+            let z0 = sys.body_coords(grp.bodies.start, q);
+            let (tip, _) = sys.beam_tip(g, q);
+            let chord = (tip - nalgebra::Vector2::new(z0[0], z0[1])).norm();
+            if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * grp.length {
+                return Err(EngineError::Stretched {
                     beam: grp.name.clone(),
                     t,
-                    deflection: defl,
+                    chord,
                     length: grp.length,
                 });
             }
-            if defl > 0.05 * grp.length && !self.warned[g] {
-                self.warned[g] = true;
-                self.messages.push(format!(
-                    "beam '{}': tip deflection {defl:.3e} m at t = {t} s is {:.1} % of its length, \
-                     beyond the small-deformation range of a single floating frame; use \
-                     substructures (or geometric_stiffening for a spinning beam)",
-                    grp.name,
-                    100.0 * defl / grp.length
-                ));
+            // each floating frame's own deformation must stay small against its length
+            for body in grp.bodies.clone() {
+                let Some(b) = sys.beam(body) else { continue };
+                let defl = b.largest_transverse(sys.body_coords(body, q));
+                if defl > b.length || !defl.is_finite() {
+                    return Err(EngineError::Runaway {
+                        beam: b.name.clone(),
+                        t,
+                        deflection: defl,
+                        length: b.length,
+                    });
+                }
+                if defl > 0.05 * b.length && !self.warned[g] {
+                    self.warned[g] = true;
+                    self.messages.push(format!(
+                        "beam '{}': deflection {defl:.3e} m of frame '{}' at t = {t} s is {:.1} % \
+                         of the frame's length, beyond the small-deformation range of a floating \
+                         frame; use (more) substructures (or geometric_stiffening for a spinning \
+                         beam)",
+                        grp.name,
+                        b.name,
+                        100.0 * defl / b.length
+                    ));
+                }
             }
         }
         Ok(())

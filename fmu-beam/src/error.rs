@@ -46,15 +46,26 @@ pub enum EngineError {
         tolerance: f64,
     },
     #[error(
-        "beam '{beam}': tip deflection {deflection:.3e} m exceeds its length {length} m at \
-         t = {t} s: the single-frame solution has run away (a linear beam spun near or above \
-         its first bending frequency softens without bound); use substructures or \
+        "beam '{beam}': deflection {deflection:.3e} m of a floating frame exceeds the frame's \
+         length {length} m at t = {t} s: the solution has run away (a linear frame spun near or \
+         above its first bending frequency softens without bound); use (more) substructures or \
          geometric_stiffening"
     )]
     Runaway {
         beam: String,
         t: f64,
         deflection: f64,
+        length: f64,
+    },
+    #[error(
+        "beam '{beam}': its tip is {chord:.4} m from its root at t = {t} s, more than 1 % beyond \
+         its length {length} m: the linear frames have stretched, the model is out of its range \
+         (more substructures, or geometric_stiffening for a spinning beam)"
+    )]
+    Stretched {
+        beam: String,
+        t: f64,
+        chord: f64,
         length: f64,
     },
     #[error("unknown value reference {vr} for a variable of type {ty}")]
@@ -86,6 +97,7 @@ impl EngineError {
                 | EngineError::NonFinite { .. }
                 | EngineError::StepTooSmall { .. }
                 | EngineError::Runaway { .. }
+                | EngineError::Stretched { .. }
         )
     }
 }

@@ -70,8 +70,8 @@ fn c4_omega10_bounded_after_spin_up_and_stiffened_single_frame_agrees() {
 }
 
 /// A single linear frame spun above its first bending frequency (2.909 rad/s) softens
-/// without bound: the FMU warns, then refuses the step that runs away (fmi2Discard) and
-/// keeps the last good state.
+/// without bound: the FMU warns, then refuses the step that leaves the model's range
+/// (fmi2Discard) and keeps the last good state.
 #[test]
 fn c4_single_frame_runaway_is_refused_with_a_message() {
     let mut e = Engine::new(scene("spin_up_omega10_single_frame.toml"));
@@ -86,11 +86,50 @@ fn c4_single_frame_runaway_is_refused_with_a_message() {
     };
     let warnings = e.take_messages();
     println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
-    assert!(matches!(err, EngineError::Runaway { .. }) && err.is_discard());
+    // the linear frame stretches (its tip drifts beyond the length from the hub) before its
+    // deflection exceeds the length: either refusal is the model leaving its range
+    assert!(
+        matches!(
+            err,
+            EngineError::Runaway { .. } | EngineError::Stretched { .. }
+        ) && err.is_discard()
+    );
     assert!(err.to_string().contains("substructures"));
     assert!(warnings
         .iter()
         .any(|w| w.contains("beam 'beam'") && w.contains("substructures")));
     assert_eq!(e.time(), t, "the last good state stays");
     assert!(t > 2.0 && t < 10.0);
+}
+
+/// Five substructures of one element are too coarse for Ω = 8 rad/s on a beam of half the
+/// stiffness: each frame deforms beyond its own length and the tip drifts beyond the beam's
+/// length from the hub (10.4 m for 8 m before this check). The step that leaves the model's range
+/// is refused with a message, and the last good state stays.
+#[test]
+fn c4_coarse_substructures_out_of_range_are_refused() {
+    let s = scene("spin_up_omega4.toml");
+    let mut e = Engine::new(s);
+    let (ev, ov) = (common::vr(&e, "beam.E"), common::vr(&e, "hub.drive.omega"));
+    e.set_real(ev, 3.4475e10).unwrap();
+    e.set_real(ov, 8.0).unwrap();
+    e.exit_initialization().unwrap();
+    let (mut t, h) = (0.0, 0.1);
+    let err = loop {
+        match e.do_step(t, h) {
+            Ok(()) => t += h,
+            Err(err) => break err,
+        }
+        assert!(t < 20.0, "the coarse substructured beam was never refused");
+    };
+    let warnings = e.take_messages();
+    println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
+    assert!(err.is_discard(), "{err}");
+    assert!(matches!(
+        err,
+        EngineError::Runaway { .. } | EngineError::Stretched { .. }
+    ));
+    assert!(err.to_string().contains("substructures"));
+    assert!(warnings.iter().any(|w| w.contains("frame 'beam[")));
+    assert_eq!(e.time(), t, "the last good state stays");
 }

@@ -343,6 +343,17 @@ impl PlanarBeam {
         }
     }
 
+    /// Largest transverse nodal displacement |v| from the frame's axis (m): how far this
+    /// frame's deformation is from the small-deformation range of a floating frame.
+    pub fn largest_transverse<'a>(&self, z: impl Coords<'a>) -> f64 {
+        let fq = self.nodal(&z.into());
+        self.kept
+            .iter()
+            .zip(fq.iter())
+            .filter(|(&k, _)| k % 3 == 1)
+            .fold(0.0, |m, (_, v)| m.max(v.abs()))
+    }
+
     /// True if deformation coordinate k is a nodal slope (an angle), false for a length or a
     /// modal amplitude.
     pub fn is_slope(&self, k: usize) -> bool {
