@@ -69,6 +69,20 @@ fn c4_omega10_bounded_after_spin_up_and_stiffened_single_frame_agrees() {
     assert!(worst < 0.05 * p_sub);
 }
 
+/// Steps of 0.1 s until the engine refuses one (20 s at most): the time reached, the error and
+/// the warnings logged on the way.
+fn run_until_refused(e: &mut Engine) -> (f64, EngineError, Vec<String>) {
+    let (mut t, h) = (0.0, 0.1);
+    let err = loop {
+        match e.do_step(t, h) {
+            Ok(()) => t += h,
+            Err(err) => break err,
+        }
+        assert!(t < 20.0, "the beam was never refused");
+    };
+    (t, err, e.take_messages())
+}
+
 /// A single linear frame spun above its first bending frequency (2.909 rad/s) softens
 /// without bound: the FMU warns, then refuses the step that leaves the model's range
 /// (fmi2Discard) and keeps the last good state.
@@ -76,15 +90,7 @@ fn c4_omega10_bounded_after_spin_up_and_stiffened_single_frame_agrees() {
 fn c4_single_frame_runaway_is_refused_with_a_message() {
     let mut e = Engine::new(scene("spin_up_omega10_single_frame.toml"));
     e.exit_initialization().unwrap();
-    let (mut t, h) = (0.0, 0.1);
-    let err = loop {
-        match e.do_step(t, h) {
-            Ok(()) => t += h,
-            Err(err) => break err,
-        }
-        assert!(t < 20.0, "the single-frame beam never ran away");
-    };
-    let warnings = e.take_messages();
+    let (t, err, warnings) = run_until_refused(&mut e);
     println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
     // the linear frame stretches (its tip drifts beyond the length from the hub) before its
     // deflection exceeds the length: either refusal is the model leaving its range
@@ -114,15 +120,7 @@ fn c4_coarse_substructures_out_of_range_are_refused() {
     e.set_real(ev, 3.4475e10).unwrap();
     e.set_real(ov, 8.0).unwrap();
     e.exit_initialization().unwrap();
-    let (mut t, h) = (0.0, 0.1);
-    let err = loop {
-        match e.do_step(t, h) {
-            Ok(()) => t += h,
-            Err(err) => break err,
-        }
-        assert!(t < 20.0, "the coarse substructured beam was never refused");
-    };
-    let warnings = e.take_messages();
+    let (t, err, warnings) = run_until_refused(&mut e);
     println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
     assert!(err.is_discard(), "{err}");
     assert!(matches!(

@@ -24,17 +24,7 @@ impl Lcg {
 }
 
 fn beam(frame: FrameKind, n: usize) -> PlanarBeam {
-    PlanarBeam::new(
-        "b",
-        0.8,
-        n,
-        frame,
-        2700.0,
-        7e9,
-        Section::rectangle(0.02, 0.01),
-        0.3,
-        2e-4,
-    )
+    beam_with(frame, n, BeamOptions::default())
 }
 
 /// Full shape rows at (element j, ξ) restricted to the kept coordinates.
