@@ -1,0 +1,61 @@
+//! `fmu-harness explain`: each resolved effect with its setting, reason and cost share; the
+//! same text is the FMU's documentation; a wrong `effects` is refused naming the field.
+
+mod common;
+use common::*;
+
+#[test]
+fn explain_prints_every_effect_with_its_reason() {
+    let scene = c1_path().with_file_name("spin_up_omega4_auto.toml");
+    let r = harness(&["explain".as_ref(), scene.as_os_str()]);
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(text.contains("(effects = auto)"), "{text}");
+    // C4 under auto: a slow ramp far below the axial modes, no gravity, rotating substructures
+    for (line_start, words) in [
+        ("gravity (scene)", &["off", "no gravity field"][..]),
+        ("axial (beam)", &["off", "first axial frequency"]),
+        ("quadratic_velocity (beam)", &["on", "rotates"]),
+        (
+            "flexibility (beam)",
+            &["5 x 1 elements", "first bending frequency"],
+        ),
+    ] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(line_start))
+            .unwrap_or_else(|| panic!("no line {line_start:?} in\n{text}"));
+        for w in words {
+            assert!(line.contains(w), "{w:?} not in {line:?}");
+        }
+    }
+    // one row per effect, each with a cost share in percent
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| {
+            fmu_beam::effects::EFFECTS
+                .iter()
+                .any(|(e, _)| l.starts_with(&format!("{e} (")))
+        })
+        .collect();
+    assert_eq!(rows.len(), 6, "{text}");
+    assert!(rows.iter().all(|l| l.contains('%')), "{text}");
+}
+
+#[test]
+fn a_wrong_effects_entry_is_refused_naming_the_field() {
+    let dir = scratch("explain_refused");
+    let scene = dir.join("warp.toml");
+    std::fs::write(
+        &scene,
+        format!("effects = [\"gravity\", \"warp\"]\n{}", c1_text()),
+    )
+    .unwrap();
+    let r = harness(&["explain".as_ref(), scene.as_os_str()]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("effects[1]") && stderr.contains("is not an effect"),
+        "{stderr}"
+    );
+}
