@@ -245,3 +245,23 @@ fn mutated_state_bytes_are_refused_not_a_panic() {
     println!("{ok} mutated states accepted, {refused} refused");
     assert!(refused > 100);
 }
+
+/// A vanishing internal step is refused, never a hang: as a scene value, and as the tunable
+/// parameter a master sets between steps (t + h == t would loop forever).
+#[test]
+fn a_vanishing_max_step_is_refused_not_a_hang() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/flexible_pendulum.toml"),
+    )
+    .unwrap();
+    let tiny = text.replace("max_step = 1e-2", "max_step = 1e-300");
+    assert_ne!(tiny, text);
+    let err = Scene::from_toml_str(&tiny, "tiny.toml").unwrap_err();
+    assert!(err.to_string().contains("solver.max_step"), "{err}");
+    let mut e = Engine::new(common::scene("flexible_pendulum.toml"));
+    e.exit_initialization().unwrap();
+    let v = common::vr(&e, "solver.max_step");
+    let err = e.set_real(v, 1e-300).unwrap_err();
+    assert!(err.to_string().contains("solver.max_step"), "{err}");
+    e.do_step(0.0, 1e-3).unwrap();
+}

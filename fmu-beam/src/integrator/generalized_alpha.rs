@@ -212,6 +212,15 @@ impl Stepper {
                 h = remaining;
             }
             let t_new = if last { target } else { st.t + h };
+            if t_new <= st.t {
+                // a step that rounds away would loop forever
+                return Err(EngineError::StepTooSmall {
+                    t: st.t,
+                    h,
+                    h_min,
+                    tolerance: set.tolerance,
+                });
+            }
             match self.attempt(sys, st, stats, h, t_new) {
                 Ok((new, err)) => {
                     if set.adaptive && err > 1.0 {

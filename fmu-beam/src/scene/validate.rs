@@ -64,6 +64,10 @@ impl Checker<'_> {
     }
 }
 
+/// The smallest internal step a scene may ask for (s): below it t + h rounds to t at the times
+/// a simulation reaches.
+pub const MIN_STEP: f64 = 1e-9;
+
 /// Characters allowed in names that become parts of FMI variable names.
 fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
@@ -90,6 +94,13 @@ impl Scene {
             return Err(ck.fail("solver.tolerance", s.tolerance, "must be below 1"));
         }
         ck.positive("solver.max_step", s.max_step)?;
+        if s.max_step < MIN_STEP {
+            return Err(ck.fail(
+                "solver.max_step",
+                s.max_step,
+                &format!("must be at least {MIN_STEP:e} s (a smaller step makes no progress)"),
+            ));
+        }
         ck.finite("solver.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {
             return Err(ck.fail("solver.rho_inf", s.rho_inf, "must lie in [0, 1]"));
