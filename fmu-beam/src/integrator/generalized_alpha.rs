@@ -11,7 +11,7 @@
 
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::multibody::System;
+use crate::multibody::{CoordinateKind, Equations};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 
 /// The integration state at a step boundary.
@@ -115,21 +115,17 @@ enum Failure {
 }
 
 impl Stepper {
-    pub fn new(sys: &System, settings: Settings) -> Stepper {
+    pub fn new<S: Equations + ?Sized>(sys: &S, settings: Settings) -> Stepper {
         let (n, m) = (sys.n(), sys.m());
         let mut scale = DVector::zeros(n);
-        for (i, b) in sys.bodies.iter().enumerate() {
-            for k in 0..b.ndof() {
-                // a body without mass has algebraic coordinates, fixed by the joints: its
-                // "acceleration" carries no error information and stays out of the norm
-                scale[sys.offsets[i] + k] = if b.is_massless() {
-                    f64::INFINITY
-                } else if b.is_angle(k) {
-                    1.0
-                } else {
-                    sys.length_scale()
-                };
-            }
+        for (k, kind) in sys.coordinate_kinds().into_iter().enumerate() {
+            // a body without mass has algebraic coordinates, fixed by the joints: its
+            // "acceleration" carries no error information and stays out of the norm
+            scale[k] = match kind {
+                CoordinateKind::Algebraic => f64::INFINITY,
+                CoordinateKind::Angle => 1.0,
+                CoordinateKind::Length => sys.length_scale(),
+            };
         }
         scale *= ERROR_SCALE;
         let algebraic = (0..n).filter(|&k| scale[k].is_infinite()).collect();
@@ -166,9 +162,9 @@ impl Stepper {
     }
 
     /// Integrates `st` to exactly `t_end`, in internal steps.
-    pub fn step_to(
+    pub fn step_to<S: Equations + ?Sized>(
         &mut self,
-        sys: &System,
+        sys: &S,
         st: &mut GaState,
         stats: &mut Stats,
         t_end: f64,
@@ -302,9 +298,9 @@ impl Stepper {
 
     /// Builds and factorizes the scaled iteration matrix at the current iterate.
     #[allow(clippy::too_many_arguments)]
-    fn factorize(
+    fn factorize<S: Equations + ?Sized>(
         &mut self,
-        sys: &System,
+        sys: &S,
         q: &DVector<f64>,
         v: &DVector<f64>,
         qdd: &DVector<f64>,
@@ -345,9 +341,9 @@ impl Stepper {
     }
 
     /// One step of size h from `st`; returns the new state and the local error norm.
-    fn attempt(
+    fn attempt<S: Equations + ?Sized>(
         &mut self,
-        sys: &System,
+        sys: &S,
         st: &GaState,
         stats: &mut Stats,
         h: f64,
@@ -453,7 +449,7 @@ impl Stepper {
 /// Restarts the scheme at a jump of a drive law: the accelerations and multipliers become those
 /// of the equations just after the jump, so that the algorithmic acceleration carries no memory
 /// of the forces before it (without this the error order drops to one at the jump).
-fn restart(sys: &System, st: &mut GaState) -> Result<(), EngineError> {
+fn restart<S: Equations + ?Sized>(sys: &S, st: &mut GaState) -> Result<(), EngineError> {
     let after = st.t * (1.0 + 1e-13) + 1e-13;
     let (qdd, lambda) = super::initial::consistent_accelerations(sys, &st.q, &st.v, after)?;
     st.acc = qdd.clone();

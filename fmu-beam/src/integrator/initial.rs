@@ -3,15 +3,15 @@
 
 use super::{GaState, Settings};
 use crate::error::EngineError;
-use crate::multibody::System;
+use crate::multibody::Equations;
 use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector};
 
 const ASSEMBLY_ITERATIONS: usize = 50;
 
 /// Builds the state at `t0` from the scene's initial configuration.
-pub fn initial_state(
-    sys: &System,
+pub fn initial_state<S: Equations + ?Sized>(
+    sys: &S,
     scene: &Scene,
     t0: f64,
     settings: &Settings,
@@ -92,7 +92,11 @@ pub fn initial_state(
 }
 
 /// Refuses redundant joints: G must have full row rank.
-fn check_rank(sys: &System, gm: &DMatrix<f64>, t: f64) -> Result<(), EngineError> {
+fn check_rank<S: Equations + ?Sized>(
+    sys: &S,
+    gm: &DMatrix<f64>,
+    t: f64,
+) -> Result<(), EngineError> {
     let m = gm.nrows();
     let svd = gm.transpose().svd(false, true);
     let smax = svd.singular_values.amax();
@@ -119,8 +123,8 @@ fn check_rank(sys: &System, gm: &DMatrix<f64>, t: f64) -> Result<(), EngineError
 }
 
 /// Solves [[M, Gᵀ], [G, 0]] [q''; λ] = [-r(q, q', 0); -bias].
-pub fn consistent_accelerations(
-    sys: &System,
+pub fn consistent_accelerations<S: Equations + ?Sized>(
+    sys: &S,
     q: &DVector<f64>,
     v: &DVector<f64>,
     t: f64,

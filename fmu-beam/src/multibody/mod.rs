@@ -1,6 +1,7 @@
 //! Bodies, frames and joints, assembled into M(q) q'' + G(q)ᵀλ = Q(q, q', t); g(q, t) = 0.
 
 pub mod body;
+pub mod equations;
 pub mod frame;
 pub mod joint;
 pub mod law;
@@ -10,4 +11,5 @@ pub mod rigid_body;
 pub mod system;
 pub mod weld;
 
+pub use equations::{CoordinateKind, Equations};
 pub use system::System;

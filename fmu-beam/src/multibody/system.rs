@@ -815,3 +815,89 @@ fn r_point(r: &RigidBody, frame: &str, z: DVectorView<f64>) -> (Vector2<f64>, f6
     let (ar, _) = rot(z[2]);
     (Vector2::new(z[0], z[1]) + ar * map.s0, z[2])
 }
+
+impl super::equations::Equations for System {
+    fn n(&self) -> usize {
+        System::n(self)
+    }
+    fn m(&self) -> usize {
+        System::m(self)
+    }
+    fn length_scale(&self) -> f64 {
+        System::length_scale(self)
+    }
+    fn coordinate_kinds(&self) -> Vec<super::equations::CoordinateKind> {
+        use super::equations::CoordinateKind;
+        let mut kinds = vec![CoordinateKind::Length; self.n];
+        for (i, b) in self.bodies.iter().enumerate() {
+            for k in 0..b.ndof() {
+                kinds[self.offsets[i] + k] = if b.is_massless() {
+                    CoordinateKind::Algebraic
+                } else if b.is_angle(k) {
+                    CoordinateKind::Angle
+                } else {
+                    CoordinateKind::Length
+                };
+            }
+        }
+        kinds
+    }
+    fn frame_coordinates(&self) -> Vec<usize> {
+        System::frame_coordinates(self)
+    }
+    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+        System::initial_coordinates(self, scene)
+    }
+    fn mass_matrix(&self, q: &DVector<f64>, m: &mut DMatrix<f64>) {
+        System::mass_matrix(self, q, m)
+    }
+    fn body_residual(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        t: f64,
+        r: &mut DVector<f64>,
+    ) {
+        System::body_residual(self, q, v, a, t, r)
+    }
+    fn tangents(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        lambda: &DVector<f64>,
+        t: f64,
+        kt: &mut DMatrix<f64>,
+        ct: &mut DMatrix<f64>,
+    ) {
+        System::tangents(self, q, v, a, lambda, t, kt, ct)
+    }
+    fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
+        System::constraints(self, q, t, g)
+    }
+    fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
+        System::constraint_jacobian(self, q, t, g)
+    }
+    fn constraints_and_jacobian(
+        &self,
+        q: &DVector<f64>,
+        t: f64,
+        g: &mut DVector<f64>,
+        gm: &mut DMatrix<f64>,
+    ) {
+        System::constraints_and_jacobian(self, q, t, g, gm)
+    }
+    fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
+        System::accel_bias(self, q, v, t, out)
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        System::breakpoints(self)
+    }
+    fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
+        System::joints_of_rows(self, rows)
+    }
+    fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
+        System::power(self, q, v, lambda, t)
+    }
+}
