@@ -12,6 +12,7 @@ pub mod fmi2;
 pub mod integrator;
 pub mod modes;
 pub mod multibody;
+pub mod multibody3d;
 pub mod scene;
 pub mod variables;
 
