@@ -283,18 +283,24 @@ fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
     (angle, rate)
 }
 
-/// Not resolved yet: the lag of this stiff steel beam (first bending ≈ 1.3 kHz) is of order
-/// 1e-7 s at 1 s, the size of the difference of time discretization between the rigid and
-/// flexible runs at h = 2.5e-4; measured 1, 2, 4, 8, 16 elements: −3.6e-7, −1.3e-7, 7.0e-8,
-/// 8.2e-8, 4.7e-8 s. Needs a much smaller step or a common-step error estimate.
+/// The lag is small (first bending ≈ 1.3 kHz): about 2.4e-6 s at 1 s, below the difference of
+/// time discretization between the rigid and flexible runs at any practical fixed step (at
+/// h = 2.5e-4 and 1e-4 the "lag" scatters by ±5e-7 s with the element count). It is resolved
+/// with the error control at tolerance 1e-9 (the rigid twin moves by 3.4e-6 rad, 3.6e-7 s,
+/// from tolerance 1e-8 to 1e-9: that is the uncertainty of the figure). Slow (≈ 2 min).
 #[test]
-#[ignore = "C6 lag below the time-discretization difference at h = 2.5e-4 (see doc)"]
+#[ignore = "slow (about 2 min at tolerance 1e-9): cargo test --release -- --ignored c6"]
 fn c6_flexible_pendulum_lags_its_rigid_twin() {
-    let settings = fixed(2.5e-4);
+    let settings = Settings {
+        adaptive: true,
+        tolerance: 1e-9,
+        max_step: 1e-3,
+        rho_inf: 0.9,
+    };
     let (ar, wr) = c6(None, settings);
     println!("C6 rigid twin: angle at 1 s {ar:.9} rad, rate {wr:.6} rad/s");
     let mut lags = Vec::new();
-    for n in [1, 2, 4, 8, 16] {
+    for n in [1, 2, 4] {
         let (a, _) = c6(Some(n), settings);
         // the time by which the flexible pendulum trails the rigid one at 1 s
         let lag = (ar - a) / wr;
@@ -302,8 +308,8 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
         lags.push(lag);
     }
     assert!(lags.iter().all(|&l| l > 0.0), "the flexible pendulum lags");
-    let (d1, d2) = ((lags[2] - lags[1]).abs(), (lags[3] - lags[2]).abs());
-    println!("lag changes with elements: 2→4 {d1:.2e} s, 4→8 {d2:.2e} s");
+    let (d1, d2) = ((lags[1] - lags[0]).abs(), (lags[2] - lags[1]).abs());
+    println!("lag changes with elements: 1→2 {d1:.2e} s, 2→4 {d2:.2e} s");
     assert!(d2 <= d1 + 1e-12, "the lag converges with elements");
 }
 
