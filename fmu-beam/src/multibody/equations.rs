@@ -17,6 +17,19 @@ pub enum CoordinateKind {
     Algebraic,
 }
 
+impl CoordinateKind {
+    /// The kind of a body's coordinate: algebraic for a massless body, else angle or length.
+    pub fn of(massless: bool, angle: bool) -> CoordinateKind {
+        if massless {
+            CoordinateKind::Algebraic
+        } else if angle {
+            CoordinateKind::Angle
+        } else {
+            CoordinateKind::Length
+        }
+    }
+}
+
 /// The equations of motion of a constrained mechanical system in index-3 form.
 pub trait Equations {
     /// Number of coordinates.

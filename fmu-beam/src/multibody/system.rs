@@ -831,13 +831,7 @@ impl super::equations::Equations for System {
         let mut kinds = vec![CoordinateKind::Length; self.n];
         for (i, b) in self.bodies.iter().enumerate() {
             for k in 0..b.ndof() {
-                kinds[self.offsets[i] + k] = if b.is_massless() {
-                    CoordinateKind::Algebraic
-                } else if b.is_angle(k) {
-                    CoordinateKind::Angle
-                } else {
-                    CoordinateKind::Length
-                };
+                kinds[self.offsets[i] + k] = CoordinateKind::of(b.is_massless(), b.is_angle(k));
             }
         }
         kinds

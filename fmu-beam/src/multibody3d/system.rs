@@ -406,13 +406,7 @@ impl Equations for System3 {
         let mut kinds = Vec::with_capacity(self.initial.len());
         for b in &self.bodies {
             for k in 0..b.ncoords() {
-                kinds.push(if b.is_massless() {
-                    CoordinateKind::Algebraic
-                } else if b.is_angle(k) {
-                    CoordinateKind::Angle
-                } else {
-                    CoordinateKind::Length
-                });
+                kinds.push(CoordinateKind::of(b.is_massless(), b.is_angle(k)));
             }
         }
         kinds
