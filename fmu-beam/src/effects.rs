@@ -201,7 +201,7 @@ fn excitation(scene: &Scene) -> (f64, String) {
             worst = (w, what);
         }
     };
-    if scene.world.gravity != [0.0, 0.0] {
+    if scene.world.gravity != [0.0; 3] {
         consider(
             f64::INFINITY,
             "gravity, switched on at t = 0 (a step)".into(),
@@ -216,7 +216,10 @@ fn excitation(scene: &Scene) -> (f64, String) {
     for l in &scene.loads {
         if l.input {
             consider(PI / h, format!("load {} (an input)", l.name));
-        } else if l.force != [0.0, 0.0] || l.torque != 0.0 {
+        } else if let Some(s) = &l.scale {
+            let w = law_bandwidth(s, DriveKind::Effort, h);
+            consider(w, format!("the {} law scaling load {}", s.law, l.name));
+        } else if l.force != [0.0; 3] || l.torque != [0.0; 3] {
             consider(f64::INFINITY, format!("load {} (a step at t = 0)", l.name));
         }
     }
@@ -248,8 +251,28 @@ fn non_rotating(scene: &Scene) -> BTreeSet<String> {
     }
 }
 
-/// Resolves the effects of a validated scene.
+/// Resolves the effects of a validated scene. A 3D scene whose motion is planar resolves as
+/// its planar reduction (and says so first); any other 3D scene as [`spatial`].
 pub fn resolve(scene: &Scene) -> Resolution {
+    if scene.is_3d() {
+        return match scene.planar_reduction() {
+            Ok(planar) => {
+                let mut r = resolve(&planar);
+                r.decisions.insert(
+                    0,
+                    Decision {
+                        effect: "formulation",
+                        subject: "scene".into(),
+                        setting: "planar".into(),
+                        why: "the motion stays in the world x-y plane (gravity, axes, loads and                               positions have no out-of-plane part): the planar element gives                               the same solution with 3 instead of 6 coordinates per node" .into(),
+                        cost_share: 0.0,
+                    },
+                );
+                r
+            }
+            Err(why) => spatial(scene, &why),
+        };
+    }
     let all = || BeamOptions::default();
     match &scene.effects {
         crate::scene::EffectsSpec::List(names) => {
@@ -298,10 +321,97 @@ pub fn resolve(scene: &Scene) -> Resolution {
     }
 }
 
+/// A scene that runs with the 3D element: gravity, flexibility and Rayleigh damping can be
+/// switched (`crate::scene::SPATIAL_EFFECTS`); the element's other terms are always on. No
+/// cost model (cost shares 0).
+fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
+    use crate::scene::EffectsSpec;
+    let (mode, on): (&'static str, Box<dyn Fn(&str) -> Option<bool>>) = match &scene.effects {
+        EffectsSpec::List(names) => {
+            let names = names.clone();
+            (
+                "list",
+                Box::new(move |e| Some(names.iter().any(|n| n == e))),
+            )
+        }
+        EffectsSpec::Mode(m) if m == "auto" => ("auto", Box::new(|_| None)),
+        EffectsSpec::Mode(_) => ("all", Box::new(|_| Some(true))),
+    };
+    let reason = |auto: &str| match mode {
+        "list" => "listed in `effects`".to_string(),
+        "all" => "effects = \"all\" (the default): the full model".to_string(),
+        _ => auto.to_string(),
+    };
+    let field = scene.world.gravity != [0.0; 3];
+    let gravity = on("gravity").unwrap_or(field);
+    let mut decisions = vec![
+        Decision {
+            effect: "formulation",
+            subject: "scene".into(),
+            setting: "spatial".into(),
+            why: format!("the 3D element: {why_3d}"),
+            cost_share: 0.0,
+        },
+        Decision {
+            effect: "gravity",
+            subject: "scene".into(),
+            setting: on_off(gravity).into(),
+            why: reason(if field {
+                "a gravity field"
+            } else {
+                "no gravity field"
+            }),
+            cost_share: 0.0,
+        },
+    ];
+    let mut beams = Vec::new();
+    for b in &scene.beams {
+        let rigid = b.rigid || !on("flexibility").unwrap_or(true);
+        let damped = b.rayleigh.alpha != 0.0 || b.rayleigh.beta != 0.0;
+        let damping = on("rayleigh_damping").unwrap_or(damped);
+        decisions.push(Decision {
+            effect: "flexibility",
+            subject: b.name.clone(),
+            setting: on_off(!rigid).into(),
+            why: if b.rigid {
+                "the scene makes the beam rigid (rigid = true)".into()
+            } else {
+                reason("auto never makes a flexible beam rigid")
+            },
+            cost_share: 0.0,
+        });
+        if !rigid {
+            decisions.push(Decision {
+                effect: "rayleigh_damping",
+                subject: b.name.clone(),
+                setting: on_off(damping).into(),
+                why: reason(if damped {
+                    "damping coefficients given"
+                } else {
+                    "both damping coefficients are zero"
+                }),
+                cost_share: 0.0,
+            });
+        }
+        beams.push(BeamEffects {
+            rigid,
+            options: BeamOptions {
+                damping,
+                ..BeamOptions::default()
+            },
+        });
+    }
+    Resolution {
+        mode,
+        effects: Effects { gravity, beams },
+        decisions,
+    }
+}
+
 /// `effects = "auto"`: the rules of the module documentation, each decision with its reason.
 fn auto(scene: &Scene) -> Resolution {
     let mut why: Vec<(&'static str, String, String)> = Vec::new();
-    let gravity = scene.world.gravity != [0.0, 0.0];
+    let gravity = scene.world.gravity != [0.0; 3];
     why.push((
         "gravity",
         "scene".into(),

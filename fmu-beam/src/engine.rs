@@ -5,8 +5,10 @@
 use crate::effects::Effects;
 use crate::error::EngineError;
 use crate::integrator::{self, GaState, Settings, Stats, Stepper};
+use crate::mechanics::Mechanics;
+use crate::multibody::equations::Equations;
 use crate::multibody::law::InputValue;
-use crate::multibody::System;
+use crate::multibody3d::System3;
 use crate::scene::Scene;
 use crate::variables::{
     Binding, Causality, OutputKind, ParamTarget, VarType, Variability, VariableTable,
@@ -15,7 +17,7 @@ use crate::variables::{
 /// A built model: the system for the current parameter values and its integration state.
 #[derive(Debug, Clone)]
 struct Model {
-    system: System,
+    system: Mechanics,
     state: GaState,
     stats: Stats,
     stepper: Stepper,
@@ -158,7 +160,7 @@ impl Engine {
         }
         self.input_ders[i][order as usize - 1] = value;
         if let Some(m) = &mut self.model {
-            let u = &mut m.system.inputs[slot];
+            let u = &mut m.system.inputs_mut()[slot];
             if order == 1 {
                 u.der1 = value;
             } else {
@@ -183,7 +185,7 @@ impl Engine {
         for (i, var) in self.table.variables.iter().enumerate() {
             if let Binding::Input(slot) = var.binding {
                 let [der1, der2] = self.input_ders[i];
-                m.system.inputs[slot] = InputValue {
+                m.system.inputs_mut()[slot] = InputValue {
                     value: self.values[i],
                     der1,
                     der2,
@@ -227,7 +229,7 @@ impl Engine {
             self.input_ders[i] = [0.0; 2];
             let t0 = self.time();
             if let Some(m) = &mut self.model {
-                m.system.inputs[slot] = InputValue {
+                m.system.inputs_mut()[slot] = InputValue {
                     value,
                     der1: 0.0,
                     der2: 0.0,
@@ -333,13 +335,12 @@ impl Engine {
             let scene = self.scene_with(&self.values);
             scene.validate("parameters")?;
             self.warn_if_auto_would_differ(&scene);
-            let system = System::build(&scene, &self.effects);
+            let mut system = Mechanics::build(&scene, &self.effects);
             let settings = Settings::from_scene(&scene);
-            let mut system = system;
             for (i, var) in self.table.variables.iter().enumerate() {
                 if let Binding::Input(slot) = var.binding {
                     let [der1, der2] = self.input_ders[i];
-                    system.inputs[slot] = InputValue {
+                    system.inputs_mut()[slot] = InputValue {
                         value: self.values[i],
                         der1,
                         der2,
@@ -348,22 +349,26 @@ impl Engine {
                 }
             }
             let state = integrator::initial_state(&system, &scene, self.start_time, &settings)?;
-            let joint_index = scene
-                .joints
-                .iter()
-                .map(|j| system.joint_index(&j.name).expect("scene joint in system"))
-                .collect();
-            let body_index = scene
-                .bodies
-                .iter()
-                .map(|b| {
-                    system
+            let (joint_index, body_index) = match &system {
+                Mechanics::Planar(sys, _) => (
+                    scene
+                        .joints
+                        .iter()
+                        .map(|j| sys.joint_index(&j.name).expect("scene joint in system"))
+                        .collect(),
+                    scene
                         .bodies
                         .iter()
-                        .position(|x| x.name() == b.name)
-                        .expect("scene body in system")
-                })
-                .collect();
+                        .map(|b| {
+                            sys.bodies
+                                .iter()
+                                .position(|x| x.name() == b.name)
+                                .expect("scene body in system")
+                        })
+                        .collect(),
+                ),
+                Mechanics::Spatial(_, index) => (index.joints.clone(), index.bodies.clone()),
+            };
             self.model = Some(Model {
                 applied_inputs: flat_inputs(&system),
                 stepper: Stepper::new(&system, settings),
@@ -442,7 +447,11 @@ impl Engine {
     /// above its first bending frequency) and the step is refused.
     fn monitor_validity(&mut self) -> Result<(), EngineError> {
         let m = self.model.as_ref().expect("model built");
-        let (sys, q, t) = (&m.system, &m.state.q, m.state.t);
+        let (q, t) = (&m.state.q, m.state.t);
+        let sys = match &m.system {
+            Mechanics::Planar(sys, _) => sys,
+            Mechanics::Spatial(sys, index) => return spatial_validity(sys, index, q, t),
+        };
         for (g, grp) in sys.beams.iter().enumerate() {
             // a beam does not stretch: a chord longer than the beam is a model out of range
             let z0 = sys.body_coords(grp.bodies.start, q);
@@ -612,6 +621,11 @@ fn apply(s: &mut Scene, t: ParamTarget, v: f64) {
     match t {
         T::GravityX => s.world.gravity[0] = v,
         T::GravityY => s.world.gravity[1] = v,
+        T::GravityZ => s.world.gravity[2] = v,
+        T::BeamG(i) => s.beams[i].material.g = Some(v),
+        T::BeamIy(i) => s.beams[i].section.iy = Some(v),
+        T::BeamIz(i) => s.beams[i].section.iz = Some(v),
+        T::BeamTorsion(i) => s.beams[i].section.torsion_constant = Some(v),
         T::SolverAdaptive => s.solver.adaptive = v != 0.0,
         T::SolverTolerance => s.solver.tolerance = v,
         T::SolverMaxStep => s.solver.max_step = v,
@@ -640,9 +654,108 @@ fn law_mut(s: &mut Scene, joint: usize) -> &mut crate::scene::LawSpec {
         .law
 }
 
+/// The spatial validity monitor: a chord longer than the beam (by [`STRETCH_LIMIT`]) is a
+/// model out of range. (The per-frame deflection warning is planar only.)
+fn spatial_validity(
+    sys: &System3,
+    index: &crate::multibody3d::build::SceneIndex,
+    q: &nalgebra::DVector<f64>,
+    t: f64,
+) -> Result<(), EngineError> {
+    for (grp, &(root, tip)) in sys.beams.iter().zip(&index.beam_frames) {
+        let chord = (sys.frame_pose(tip, q).0 - sys.frame_pose(root, q).0).norm();
+        if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * grp.length {
+            return Err(EngineError::Stretched {
+                beam: grp.name.clone(),
+                t,
+                chord,
+                length: grp.length,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A 3D output of a planar model (a 3D scene reduced to the plane): nothing leaves the plane.
+fn planar_3d(sys: &crate::multibody::System, q: &nalgebra::DVector<f64>, kind: OutputKind) -> f64 {
+    use OutputKind as K;
+    match kind {
+        K::TipDeflectionY(g) => sys.beam_transverse(g, q, sys.beam_tip(g, q).0),
+        _ => 0.0, // tip z, deflection along z, twist and body z
+    }
+}
+
+/// An output of a spatial model.
+fn spatial_output(
+    m: &Model,
+    sys: &System3,
+    index: &crate::multibody3d::build::SceneIndex,
+    kind: OutputKind,
+) -> f64 {
+    use OutputKind as K;
+    let st = &m.state;
+    let (q, v) = (&st.q, &st.v);
+    // the tip relative to the root frame: position, and rotation root → tip
+    let local = |g: usize| {
+        let (root, tip) = index.beam_frames[g];
+        let (x0, a0) = sys.frame_pose(root, q);
+        let (x1, a1) = sys.frame_pose(tip, q);
+        (a0.transpose() * (x1 - x0), a0.transpose() * a1)
+    };
+    let tip = |g: usize| sys.frame_pose(index.beam_frames[g].1, q).0;
+    let body = |b: usize| sys.offsets[m.body_index[b]];
+    match kind {
+        K::TipX(g) => tip(g)[0],
+        K::TipY(g) => tip(g)[1],
+        K::TipZ(g) => tip(g)[2],
+        K::TipDeflectionY(g) | K::TipDeflection(g) => local(g).0[1],
+        K::TipDeflectionZ(g) => local(g).0[2],
+        // the rotation about the beam axis: exact for a pure twist, the axial part of the
+        // relative rotation with bending
+        K::TipTwist(g) => {
+            let r = local(g).1;
+            (r[(2, 1)] - r[(1, 2)]).atan2(r[(1, 1)] + r[(2, 2)])
+        }
+        K::JointCoordinate(j) => sys.joint_coordinate(m.joint_index[j], q),
+        K::JointRate(j) => sys.joint_rate(m.joint_index[j], q, v),
+        K::JointEffort(j) => sys.joint_effort(m.joint_index[j], &st.lambda, st.t),
+        K::BodyX(b) => q[body(b)],
+        K::BodyY(b) => q[body(b) + 1],
+        K::BodyZ(b) => q[body(b) + 2],
+        K::EnergyKinetic => sys.energy(q, v).kinetic,
+        K::EnergyStrain => sys.energy(q, v).strain,
+        K::EnergyPotential => sys.energy(q, v).potential,
+        K::EnergyTotal => sys.energy(q, v).total(),
+        _ => common_output(m, kind),
+    }
+}
+
+/// Outputs that do not depend on the kind of system.
+fn common_output(m: &Model, kind: OutputKind) -> f64 {
+    use OutputKind as K;
+    let st = &m.state;
+    match kind {
+        K::EnergyWork => st.work,
+        K::SolverSteps => m.stats.steps as f64,
+        K::SolverNewtonIterations => m.stats.newton_iterations as f64,
+        K::SolverJacobians => m.stats.jacobians as f64,
+        K::SolverRejectedSteps => m.stats.rejected as f64,
+        K::ConstraintResidual => {
+            let mut g = nalgebra::DVector::zeros(m.system.m());
+            m.system.constraints(&st.q, st.t, &mut g);
+            g.amax()
+        }
+        // no other output is offered by a scene whose system lacks it
+        _ => f64::NAN,
+    }
+}
+
 fn output(m: &Model, kind: OutputKind) -> f64 {
     use OutputKind as K;
-    let sys = &m.system;
+    let sys = match &m.system {
+        Mechanics::Planar(sys, _) => sys,
+        Mechanics::Spatial(sys, index) => return spatial_output(m, sys, index, kind),
+    };
     let st = &m.state;
     let (q, v) = (&st.q, &st.v);
     match kind {
@@ -659,30 +772,24 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
         K::BodyX(b) => q[sys.offsets[m.body_index[b]]],
         K::BodyY(b) => q[sys.offsets[m.body_index[b]] + 1],
         K::BodyPhi(b) => q[sys.offsets[m.body_index[b]] + 2],
-        K::EnergyWork => st.work,
         K::EnergyKinetic => sys.energy(q, v).kinetic,
         K::EnergyStrain => sys.energy(q, v).strain,
         K::EnergyPotential => sys.energy(q, v).potential,
         K::EnergyTotal => sys.energy(q, v).total(),
-        K::SolverSteps => m.stats.steps as f64,
-        K::SolverNewtonIterations => m.stats.newton_iterations as f64,
-        K::SolverJacobians => m.stats.jacobians as f64,
-        K::SolverRejectedSteps => m.stats.rejected as f64,
-        K::ConstraintResidual => {
-            let mut g = nalgebra::DVector::zeros(sys.m());
-            sys.constraints(q, st.t, &mut g);
-            g.amax()
+        K::TipZ(_) | K::TipDeflectionY(_) | K::TipDeflectionZ(_) | K::TipTwist(_) | K::BodyZ(_) => {
+            planar_3d(sys, q, kind)
         }
+        _ => common_output(m, kind),
     }
 }
 
-fn beam_section(sys: &System, g: usize) -> crate::beam::section::Section {
+fn beam_section(sys: &crate::multibody::System, g: usize) -> crate::beam::section::Section {
     sys.beams[g].section
 }
 
 /// Values and derivatives of the system's inputs, 3 per input.
-fn flat_inputs(sys: &System) -> Vec<f64> {
-    sys.inputs
+fn flat_inputs(sys: &Mechanics) -> Vec<f64> {
+    sys.inputs()
         .iter()
         .flat_map(|u| [u.value, u.der1, u.der2])
         .collect()

@@ -80,6 +80,7 @@ impl Initial {
 pub enum ParamTarget {
     GravityX,
     GravityY,
+    GravityZ,
     SolverAdaptive,
     SolverTolerance,
     SolverMaxStep,
@@ -87,8 +88,12 @@ pub enum ParamTarget {
     BeamLength(usize),
     BeamRho(usize),
     BeamE(usize),
+    BeamG(usize),
     BeamArea(usize),
     BeamSecondMoment(usize),
+    BeamIy(usize),
+    BeamIz(usize),
+    BeamTorsion(usize),
     BeamRayleighAlpha(usize),
     BeamRayleighBeta(usize),
     BeamTipDisplacement(usize),
@@ -108,6 +113,12 @@ pub enum OutputKind {
     TipX(usize),
     TipY(usize),
     TipPhi(usize),
+    /// 3D: world z of flange b; its displacement along the root frame's y and z axes from the
+    /// root axis (m); its rotation about the beam axis relative to the root (rad).
+    TipZ(usize),
+    TipDeflectionY(usize),
+    TipDeflectionZ(usize),
+    TipTwist(usize),
     /// Transverse displacement at mid-span from the root axis (tangent) or the chord (pinned).
     MidDeflection(usize),
     /// Joint coordinate, its rate, and the effort of its drive (scene joint index).
@@ -117,6 +128,7 @@ pub enum OutputKind {
     /// Pose of a rigid body (scene body index).
     BodyX(usize),
     BodyY(usize),
+    BodyZ(usize),
     BodyPhi(usize),
     /// Work done by drives and loads since the start (J).
     EnergyWork,
@@ -250,6 +262,17 @@ impl VariableTable {
                 V::Fixed,
                 "Gravity, world y",
             );
+            if scene.is_3d() {
+                real_param(
+                    &mut t,
+                    "world.gravity.z".into(),
+                    T::GravityZ,
+                    "m/s2",
+                    g[2],
+                    V::Fixed,
+                    "Gravity, world z",
+                );
+            }
         }
         let s = &scene.solver;
         t.push(
@@ -309,7 +332,8 @@ impl VariableTable {
                 V::Fixed,
                 "Density",
             );
-            if !fx.rigid {
+            let matrices = b.matrix_text.is_some();
+            if !fx.rigid && !matrices {
                 real_param(
                     &mut t,
                     format!("{n}.E"),
@@ -320,7 +344,9 @@ impl VariableTable {
                     "Young's modulus",
                 );
             }
-            if b.section.shape.is_none() {
+            if scene.is_3d() {
+                spatial_section_params(&mut t, b, i, fx.rigid);
+            } else if b.section.shape.is_none() {
                 real_param(
                     &mut t,
                     format!("{n}.A"),
@@ -383,6 +409,9 @@ impl VariableTable {
                     V::Fixed,
                     "Rayleigh damping, stiffness-proportional",
                 );
+            }
+            if scene.is_3d() {
+                continue;
             }
             real_param(
                 &mut t,
@@ -478,8 +507,8 @@ impl VariableTable {
             );
         }
         for (i, (b, fx)) in scene.beams.iter().zip(&effects.beams).enumerate() {
-            for o in Scene::beam_outputs(b) {
-                if fx.rigid && o.ends_with("deflection") {
+            for o in scene.beam_outputs(b) {
+                if fx.rigid && (o.contains("deflection") || o == "tip.twist") {
                     continue; // a rigid beam does not deflect
                 }
                 let (kind, unit, desc) = match o {
@@ -490,6 +519,13 @@ impl VariableTable {
                     ),
                     "tip.x" => (K::TipX(i), "m", "World x of flange b"),
                     "tip.y" => (K::TipY(i), "m", "World y of flange b"),
+                    "tip.z" => (K::TipZ(i), "m", "World z of flange b"),
+                    "tip.deflection_y" => (K::TipDeflectionY(i), "m",
+                        "Displacement of flange b along the root frame's y axis, from the root axis"),
+                    "tip.deflection_z" => (K::TipDeflectionZ(i), "m",
+                        "Displacement of flange b along the root frame's z axis, from the root axis"),
+                    "tip.twist" => (K::TipTwist(i), "rad",
+                        "Rotation of flange b about the beam axis, relative to the root frame"),
                     "mid.deflection" => (K::MidDeflection(i), "m",
                         "Transverse displacement at mid-span from the root axis (the chord for a pinned frame)"),
                     _ => (K::TipPhi(i), "rad", "World rotation of flange b"),
@@ -542,7 +578,7 @@ impl VariableTable {
                     t.output(format!("{n}.force"), VarType::Real, Some("N"),
                         "Force of the joint's drive on frame 1 along the axis (the reaction of a motion drive; 0 without drive)", K::JointEffort(i));
                 }
-                crate::scene::JointKind::Weld => {}
+                crate::scene::JointKind::Weld | crate::scene::JointKind::Spherical => {}
             }
         }
         for (i, b) in scene.bodies.iter().enumerate() {
@@ -561,6 +597,16 @@ impl VariableTable {
                 "World y of the body frame",
                 K::BodyY(i),
             );
+            if scene.is_3d() {
+                t.output(
+                    format!("{n}.z"),
+                    VarType::Real,
+                    Some("m"),
+                    "World z of the body frame",
+                    K::BodyZ(i),
+                );
+                continue;
+            }
             t.output(
                 format!("{n}.phi"),
                 VarType::Real,
@@ -644,6 +690,72 @@ impl VariableTable {
             .filter(|u| self.variables.iter().any(|v| v.unit == Some(u.name)))
             .collect()
     }
+}
+
+/// The shear modulus and the section constants given directly of a 3D beam (a section from a
+/// shape or a matrix file has none to set).
+fn spatial_section_params(t: &mut Builder, b: &crate::scene::BeamSpec, i: usize, rigid: bool) {
+    use ParamTarget as T;
+    let n = &b.name;
+    let mut param = |name: &str, target, unit, v: f64, desc: &str| {
+        t.push(
+            format!("{n}.{name}"),
+            VarType::Real,
+            Causality::Parameter,
+            Variability::Fixed,
+            Some(unit),
+            desc,
+            Some(v),
+            Binding::Parameter(target),
+        );
+    };
+    if b.matrix_text.is_some() {
+        return;
+    }
+    if !rigid {
+        param(
+            "G",
+            T::BeamG(i),
+            "Pa",
+            b.material.g.unwrap_or(0.0),
+            "Shear modulus",
+        );
+    }
+    let s = &b.section;
+    if s.shape.is_some() {
+        return;
+    }
+    param(
+        "A",
+        T::BeamArea(i),
+        "m2",
+        s.area.unwrap_or(0.0),
+        "Section area",
+    );
+    if rigid {
+        return;
+    }
+    param(
+        "Iy",
+        T::BeamIy(i),
+        "m4",
+        s.iy.unwrap_or(0.0),
+        "Second moment of area Iy (bending in the local x-z plane)",
+    );
+    param(
+        "Iz",
+        T::BeamIz(i),
+        "m4",
+        s.iz.unwrap_or(0.0),
+        "Second moment of area Iz (bending in the local x-y plane)",
+    );
+    param(
+        "It",
+        T::BeamTorsion(i),
+        "m4",
+        s.torsion_constant.unwrap_or(0.0),
+        "Saint-Venant torsion constant",
+    );
 }
 
 struct Builder {

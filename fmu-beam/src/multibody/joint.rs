@@ -117,7 +117,8 @@ impl Joint {
         let motion = drive.is_some_and(|d| d.kind == DriveKind::Motion) as usize;
         match kind {
             JointKind::Weld => 3,
-            JointKind::Revolute | JointKind::Prismatic => 2 + motion,
+            // in the plane a spherical joint acts as a revolute one
+            JointKind::Revolute | JointKind::Spherical | JointKind::Prismatic => 2 + motion,
         }
     }
 
@@ -133,7 +134,7 @@ impl Joint {
     pub fn rows(&self, f0: &FrameState, f1: &FrameState, t: f64, inputs: &[InputValue]) -> Rows {
         let mut rows = match self.kind {
             JointKind::Weld => weld::rows(f0, f1, self.angle_offset),
-            JointKind::Revolute => revolute::rows(f0, f1),
+            JointKind::Revolute | JointKind::Spherical => revolute::rows(f0, f1),
             JointKind::Prismatic => prismatic::rows(f0, f1, self.axis_angle, self.angle_offset),
         };
         if let Some(d) = self.drive.as_ref().filter(|d| d.kind == DriveKind::Motion) {

@@ -59,11 +59,21 @@ pub fn input_slots(scene: &Scene) -> Vec<InputSlot> {
         }
     }
     for l in scene.loads.iter().filter(|l| l.input) {
-        for (what, unit, start) in [
+        let planar = [
             ("fx", "N", l.force[0]),
             ("fy", "N", l.force[1]),
-            ("torque", "N.m", l.torque),
-        ] {
+            ("torque", "N.m", l.torque[2]),
+        ];
+        let spatial = [
+            ("fx", "N", l.force[0]),
+            ("fy", "N", l.force[1]),
+            ("fz", "N", l.force[2]),
+            ("tx", "N.m", l.torque[0]),
+            ("ty", "N.m", l.torque[1]),
+            ("tz", "N.m", l.torque[2]),
+        ];
+        let parts: &[(&str, &'static str, f64)] = if scene.is_3d() { &spatial } else { &planar };
+        for &(what, unit, start) in parts {
             slots.push(InputSlot {
                 name: format!("{}.{what}", l.name),
                 unit,
@@ -84,6 +94,8 @@ pub struct Load {
     pub torque: f64,
     /// Input slots of fx, fy, torque.
     pub inputs: Option<usize>,
+    /// A time law that scales the constant force and torque (a ramp, say).
+    pub scale: Option<TimeLaw>,
 }
 
 /// A scene beam: one body, or k substructures welded tip to root.
@@ -185,11 +197,11 @@ impl System {
                 name: spec.name.clone(),
                 mass: spec.mass,
                 com: Vector2::new(spec.com[0], spec.com[1]),
-                inertia: spec.inertia,
+                inertia: spec.inertia[2],
                 frames: spec
                     .frames
                     .iter()
-                    .map(|(n, p)| (n.clone(), Vector2::new(p[0], p[1])))
+                    .map(|(n, p)| (n.clone(), Vector2::new(p.0[0], p.0[1])))
                     .collect(),
                 counts: Default::default(),
             }));
@@ -296,8 +308,9 @@ impl System {
                 name: l.name.clone(),
                 frame,
                 force: Vector2::new(l.force[0], l.force[1]),
-                torque: l.torque,
+                torque: l.torque[2],
                 inputs,
+                scale: l.scale.as_ref().map(|s| TimeLaw::from_spec(s, None)),
             });
         }
         sys
@@ -549,7 +562,10 @@ impl System {
 
     /// Force and torque of load `l` at time t.
     fn load_value(&self, l: &Load, t: f64) -> (Vector2<f64>, f64) {
-        let _ = t;
+        if let Some(s) = &l.scale {
+            let k = s.eval(t, &self.inputs).0;
+            return (l.force * k, l.torque * k);
+        }
         match l.inputs {
             Some(s) => (
                 Vector2::new(self.input_at(s, t), self.input_at(s + 1, t)),
@@ -713,7 +729,9 @@ impl System {
             .joints
             .iter()
             .filter_map(|j| j.drive.as_ref())
-            .flat_map(|d| d.law.breakpoints())
+            .map(|d| &d.law)
+            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
+            .flat_map(TimeLaw::breakpoints)
             .collect();
         b.sort_by(|x, y| x.total_cmp(y));
         b.dedup();

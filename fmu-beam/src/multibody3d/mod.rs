@@ -27,6 +27,7 @@
 //! difference of g along q' plus the drive law's second derivative. The norm rows are exact.
 
 pub mod body;
+pub mod build;
 pub mod frame;
 pub mod joint;
 pub mod quaternion;

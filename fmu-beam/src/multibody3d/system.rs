@@ -139,6 +139,25 @@ impl System3 {
         self.beams.len() - 1
     }
 
+    /// Adds one prebuilt beam body (from a matrix file, say) as a beam of one floating frame.
+    /// Returns the beam's index in `beams`.
+    pub fn add_beam_body(
+        &mut self,
+        beam: SpatialBeam,
+        position: Vector3<f64>,
+        rotation: Matrix3<f64>,
+    ) -> usize {
+        let first = self.bodies.len();
+        let (name, length) = (beam.name.clone(), beam.length);
+        self.add_body(Body3::Beam(Box::new(beam)), position, &rotation);
+        self.beams.push(BeamGroup3 {
+            name,
+            bodies: first..first + 1,
+            length,
+        });
+        self.beams.len() - 1
+    }
+
     fn beam_flange(&mut self, body: usize, tip: bool) -> usize {
         let Body3::Beam(b) = &self.bodies[body] else {
             panic!("body {body} is not a beam");
@@ -263,6 +282,27 @@ impl System3 {
             &self.frame_pose(jt.frames[0], q),
             &self.frame_pose(jt.frames[1], q),
         )
+    }
+
+    /// Rate of joint `j`'s coordinate: ∂θ/∂q · q'.
+    pub fn joint_rate(&self, j: usize, q: &DVector<f64>, v: &DVector<f64>) -> f64 {
+        self.coordinate_gradient(j, q)
+            .into_iter()
+            .map(|(k, d)| d * v[k])
+            .sum()
+    }
+
+    /// Effort of joint `j`'s drive on frame 1 along its coordinate: the effort law, or −λ of
+    /// the motion row; 0 without a drive.
+    pub fn joint_effort(&self, j: usize, lambda: &DVector<f64>, t: f64) -> f64 {
+        let jt = &self.joints[j];
+        if let Some(e) = jt.effort(t, &self.inputs) {
+            e
+        } else if jt.drive_acceleration(t, &self.inputs).is_some() {
+            -lambda[self.joint_row(j) + jt.len() - 1]
+        } else {
+            0.0
+        }
     }
 
     /// ∂(joint coordinate)/∂q over the joint's columns (central differences).

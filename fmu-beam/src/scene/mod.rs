@@ -4,12 +4,21 @@
 //! experiment. Unknown keys are refused by serde (`deny_unknown_fields`); every value rule is
 //! checked in [`validate`], whose errors name the field and the rule.
 
+mod planar;
+mod space;
 mod validate;
+pub mod xyz;
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub use space::SPATIAL_EFFECTS;
 pub use validate::SceneError;
+
+/// The default number of space dimensions of a scene.
+fn two() -> u8 {
+    2
+}
 
 /// A whole scene, as read from its TOML file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -19,6 +28,15 @@ pub struct Scene {
     pub name: String,
     #[serde(default)]
     pub description: String,
+    /// 2 (default): a planar scene in the world x–y plane; 3: a spatial scene (3D beams,
+    /// frames and joints, vectors with 3 components).
+    #[serde(default = "two")]
+    pub dimensions: u8,
+    /// Which beam element a 3D scene runs with: `auto` (the planar element when the scene's
+    /// motion stays in the world x–y plane, [`Scene::planar_reduction`]) or `spatial` (always
+    /// the 3D element).
+    #[serde(default)]
+    pub formulation: Formulation,
     #[serde(default)]
     pub world: World,
     #[serde(default)]
@@ -53,12 +71,23 @@ impl Default for EffectsSpec {
     }
 }
 
-/// The world: its gravity field (m/s^2, world axes).
+/// Which element a 3D scene runs with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Formulation {
+    /// The planar element when the motion is planar, else the spatial one.
+    #[default]
+    Auto,
+    /// Always the spatial element.
+    Spatial,
+}
+
+/// The world: its gravity field (m/s^2, world axes; `[gx, gy]` or `[gx, gy, gz]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct World {
-    #[serde(default)]
-    pub gravity: [f64; 2],
+    #[serde(default, with = "xyz::point")]
+    pub gravity: [f64; 3],
 }
 
 /// Integrator settings; each becomes a tunable FMU parameter `solver.<field>`.
@@ -162,15 +191,45 @@ pub struct BeamSpec {
     #[serde(default)]
     pub frame: FrameKind,
     pub material: MaterialSpec,
+    /// Required, except for a beam from a matrix file.
+    #[serde(default)]
     pub section: SectionSpec,
     #[serde(default)]
     pub rayleigh: RayleighSpec,
     /// World position of flange a (m) in the undeformed initial configuration.
-    #[serde(default)]
-    pub position: [f64; 2],
-    /// World angle of the beam axis (rad) in the initial configuration.
+    #[serde(default, with = "xyz::point")]
+    pub position: [f64; 3],
+    /// World angle of the beam axis (rad) in the initial configuration (planar scenes, and
+    /// the default axis of a 3D beam: in the x–y plane).
     #[serde(default)]
     pub angle: f64,
+    /// 3D: world direction of the beam axis (local x) at t = 0 (default: from `angle`).
+    #[serde(
+        default,
+        with = "xyz::direction",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub axis: Option<[f64; 3]>,
+    /// 3D: world direction of the section's local z axis at t = 0, normal to `axis`
+    /// (default: world z). Bending in the local x–y plane uses `Iz`, in x–z `Iy`.
+    #[serde(
+        default,
+        with = "xyz::direction",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub normal: Option<[f64; 3]>,
+    /// 3D: `full` inertia, or `frozen` (3D paper §6: constant mass matrix, no
+    /// quadratic-velocity update; the fast variant).
+    #[serde(default)]
+    pub inertia: InertiaSpec,
+    /// 3D: a one-element beam whose 12 × 12 mass and stiffness come from this file
+    /// (`crate::beam::matrix_file` documents the format), relative to the scene file.
+    /// [`Scene::load`] reads it into `matrix_text`, which the FMU carries.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix_file: Option<String>,
+    /// The matrix file's text (filled by [`Scene::load`]; written into the packaged scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix_text: Option<String>,
     #[serde(default)]
     pub initial: InitialSpec,
     /// Outputs to offer; empty means all of [`BEAM_OUTPUTS`].
@@ -186,6 +245,25 @@ pub const BEAM_OUTPUTS: [&str; 5] = [
     "tip.phi",
     "mid.deflection",
 ];
+
+/// The outputs a 3D beam offers, by their name after `<beam>.`.
+pub const BEAM_OUTPUTS_3D: [&str; 6] = [
+    "tip.x",
+    "tip.y",
+    "tip.z",
+    "tip.deflection_y",
+    "tip.deflection_z",
+    "tip.twist",
+];
+
+/// Inertia model of a 3D beam.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum InertiaSpec {
+    #[default]
+    Full,
+    Frozen,
+}
 
 /// Reference frame conventions of the planar paper §3.3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -219,9 +297,17 @@ pub struct SectionSpec {
     /// Area (m^2), given directly.
     #[serde(rename = "A", default)]
     pub area: Option<f64>,
-    /// Second moment of area for in-plane bending (m^4), given directly.
-    #[serde(rename = "J", default)]
+    /// Second moment of area for in-plane bending (m^4), given directly (planar scenes).
+    #[serde(rename = "J", default, skip_serializing_if = "Option::is_none")]
     pub second_moment: Option<f64>,
+    /// 3D, given directly: second moments I_y = ∫z² dA (bending in x–z) and I_z = ∫y² dA
+    /// (bending in x–y), and the Saint-Venant torsion constant (m^4).
+    #[serde(rename = "Iy", default, skip_serializing_if = "Option::is_none")]
+    pub iy: Option<f64>,
+    #[serde(rename = "Iz", default, skip_serializing_if = "Option::is_none")]
+    pub iz: Option<f64>,
+    #[serde(rename = "It", default, skip_serializing_if = "Option::is_none")]
+    pub torsion_constant: Option<f64>,
     /// `rectangle`, `circle`, `hollow_rectangle`, `hollow_circle`.
     #[serde(default)]
     pub shape: Option<String>,
@@ -255,27 +341,28 @@ pub struct InitialSpec {
     pub tip_displacement: f64,
 }
 
-/// A planar rigid body.
+/// A rigid body (planar, or 3D with its frame parallel to the world's at t = 0).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidBodySpec {
     pub name: String,
     /// Mass (kg); zero is allowed when joints fix every coordinate of the body.
     pub mass: f64,
-    /// Moment of inertia about the centre of mass (kg m^2).
-    #[serde(default)]
-    pub inertia: f64,
+    /// Moment of inertia about the centre of mass (kg m^2): a number (about z) or, in 3D,
+    /// the principal moments `[Ixx, Iyy, Izz]` along the body axes.
+    #[serde(default, with = "xyz::about_z")]
+    pub inertia: [f64; 3],
     /// Centre of mass in the body frame (m).
-    #[serde(default)]
-    pub com: [f64; 2],
-    /// World position (m) and angle (rad) of the body frame at t = 0.
-    #[serde(default)]
-    pub position: [f64; 2],
+    #[serde(default, with = "xyz::point")]
+    pub com: [f64; 3],
+    /// World position (m) and angle (rad, about z) of the body frame at t = 0.
+    #[serde(default, with = "xyz::point")]
+    pub position: [f64; 3],
     #[serde(default)]
     pub angle: f64,
     /// Named frames (positions in the body frame); `origin` and `com` always exist.
     #[serde(default)]
-    pub frames: std::collections::BTreeMap<String, [f64; 2]>,
+    pub frames: std::collections::BTreeMap<String, Point>,
 }
 
 /// A joint between two frames: `world`, `<beam>.a`, `<beam>.b`, `<body>.<frame>`.
@@ -290,6 +377,15 @@ pub struct JointSpec {
     pub frames: [String; 2],
     #[serde(default)]
     pub axis_angle: f64,
+    /// 3D: world direction, at t = 0, of a revolute joint's rotation axis or a prismatic
+    /// joint's sliding axis (default: world z for a revolute joint, the first frame's x axis
+    /// turned by `axis_angle` about z for a prismatic one).
+    #[serde(
+        default,
+        with = "xyz::direction",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub axis: Option<[f64; 3]>,
     #[serde(default)]
     pub drive: Option<DriveSpec>,
 }
@@ -303,6 +399,8 @@ pub enum JointKind {
     Revolute,
     /// Same angle, free sliding along an axis.
     Prismatic,
+    /// 3D: same position, free rotation about any axis.
+    Spherical,
 }
 
 /// What drives a revolute or prismatic joint.
@@ -352,34 +450,67 @@ pub struct LawSpec {
 pub struct LoadSpec {
     pub name: String,
     pub frame: String,
-    #[serde(default)]
-    pub force: [f64; 2],
-    #[serde(default)]
-    pub torque: f64,
-    /// Offer `<load>.fx`, `<load>.fy`, `<load>.torque` as FMU inputs (start: the values above).
+    #[serde(default, with = "xyz::point")]
+    pub force: [f64; 3],
+    /// A number (about z) or, in 3D, `[tx, ty, tz]` (world axes).
+    #[serde(default, with = "xyz::about_z")]
+    pub torque: [f64; 3],
+    /// Offer `<load>.fx`, `<load>.fy`, `<load>.torque` (3D: `.fz`, `.tx`, `.ty`, `.tz`) as FMU
+    /// inputs (start: the values above).
     #[serde(default)]
     pub input: bool,
+    /// The force and torque are scaled by this time law (e.g. a slow ramp); not with `input`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<LawSpec>,
 }
+
+/// A point in a body frame: `[x, y]` or `[x, y, z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Point(#[serde(with = "xyz::point")] pub [f64; 3]);
 
 impl Scene {
     /// Parses and validates scene text; `origin` (a file name) prefixes every message.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Scene, SceneError> {
-        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
-            origin: origin.to_string(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let scene = Scene::parse(text, origin)?;
         scene.validate(origin)?;
         Ok(scene)
     }
 
-    /// Reads, parses and validates a scene file.
+    fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        toml::from_str(text).map_err(|e| SceneError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })
+    }
+
+    /// Reads, parses and validates a scene file; a beam's `matrix_file` is read (relative to
+    /// the scene file) into its `matrix_text`, unless the text is there already.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let origin = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
             origin: origin.clone(),
             message: e.to_string(),
         })?;
-        Scene::from_toml_str(&text, &origin)
+        let mut scene = Scene::parse(&text, &origin)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        for (i, b) in scene.beams.iter_mut().enumerate() {
+            // a packaged scene carries the text already
+            if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
+                let text = std::fs::read_to_string(dir.join(file)).map_err(|e| SceneError::Io {
+                    origin: format!("{origin}: beam[{i}].matrix_file = {file:?}"),
+                    message: e.to_string(),
+                })?;
+                b.matrix_text = Some(text);
+            }
+        }
+        scene.validate(&origin)?;
+        Ok(scene)
+    }
+
+    /// A 3D scene (`dimensions = 3`)?
+    pub fn is_3d(&self) -> bool {
+        self.dimensions == 3
     }
 
     /// The canonical TOML text of this scene (what the packager writes into the FMU).
@@ -400,9 +531,13 @@ impl Scene {
     }
 
     /// The outputs of a beam, resolved (an empty list means all).
-    pub fn beam_outputs(beam: &BeamSpec) -> Vec<&'static str> {
-        BEAM_OUTPUTS
-            .iter()
+    pub fn beam_outputs(&self, beam: &BeamSpec) -> Vec<&'static str> {
+        let all: &[&'static str] = if self.is_3d() {
+            &BEAM_OUTPUTS_3D
+        } else {
+            &BEAM_OUTPUTS
+        };
+        all.iter()
             .copied()
             .filter(|o| beam.outputs.is_empty() || beam.outputs.iter().any(|x| x == o))
             .collect()

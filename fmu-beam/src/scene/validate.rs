@@ -2,7 +2,7 @@
 
 use super::{
     BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
-    SectionSpec, BEAM_OUTPUTS,
+    SectionSpec,
 };
 use crate::effects::EFFECTS;
 use thiserror::Error;
@@ -23,12 +23,17 @@ pub enum SceneError {
     },
 }
 
-struct Checker<'a> {
-    origin: &'a str,
+pub(super) struct Checker<'a> {
+    pub(super) origin: &'a str,
 }
 
 impl Checker<'_> {
-    fn fail(&self, field: &str, value: impl std::fmt::Display, rule: &str) -> SceneError {
+    pub(super) fn fail(
+        &self,
+        field: &str,
+        value: impl std::fmt::Display,
+        rule: &str,
+    ) -> SceneError {
         SceneError::Invalid {
             origin: self.origin.to_string(),
             field: field.to_string(),
@@ -37,7 +42,7 @@ impl Checker<'_> {
         }
     }
 
-    fn finite(&self, field: &str, v: f64) -> Result<(), SceneError> {
+    pub(super) fn finite(&self, field: &str, v: f64) -> Result<(), SceneError> {
         if v.is_finite() {
             Ok(())
         } else {
@@ -45,7 +50,7 @@ impl Checker<'_> {
         }
     }
 
-    fn positive(&self, field: &str, v: f64) -> Result<(), SceneError> {
+    pub(super) fn positive(&self, field: &str, v: f64) -> Result<(), SceneError> {
         self.finite(field, v)?;
         if v > 0.0 {
             Ok(())
@@ -54,7 +59,7 @@ impl Checker<'_> {
         }
     }
 
-    fn non_negative(&self, field: &str, v: f64) -> Result<(), SceneError> {
+    pub(super) fn non_negative(&self, field: &str, v: f64) -> Result<(), SceneError> {
         self.finite(field, v)?;
         if v >= 0.0 {
             Ok(())
@@ -69,7 +74,7 @@ impl Checker<'_> {
 pub const MIN_STEP: f64 = 1e-9;
 
 /// Characters allowed in names that become parts of FMI variable names.
-fn is_identifier(s: &str) -> bool {
+pub(super) fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
@@ -83,6 +88,13 @@ impl Scene {
                 "name",
                 format!("{:?}", self.name),
                 "must be an identifier (letters, digits, _; not starting with a digit)",
+            ));
+        }
+        if !matches!(self.dimensions, 2 | 3) {
+            return Err(ck.fail(
+                "dimensions",
+                self.dimensions,
+                "must be 2 (planar) or 3 (spatial)",
             ));
         }
         for (i, g) in self.world.gravity.iter().enumerate() {
@@ -121,7 +133,7 @@ impl Scene {
             return Err(ck.fail("beam", "[]", "a scene needs at least one [[beam]]"));
         }
         for (i, b) in self.beams.iter().enumerate() {
-            validate_beam(&ck, b, i)?;
+            validate_beam(&ck, b, i, self.is_3d())?;
             if self.beams[..i].iter().any(|o| o.name == b.name) {
                 return Err(ck.fail(
                     &format!("beam[{i}].name"),
@@ -132,7 +144,7 @@ impl Scene {
         }
         validate_effects(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
-            validate_body(&ck, b, i)?;
+            validate_body(&ck, b, i, self.is_3d())?;
         }
         let mut names: Vec<(&str, String)> = Vec::new();
         let all = self
@@ -228,11 +240,22 @@ impl Scene {
                     "a load acts on a body",
                 ));
             }
-            ck.finite(&format!("{field}.force[0]"), l.force[0])?;
-            ck.finite(&format!("{field}.force[1]"), l.force[1])?;
-            ck.finite(&format!("{field}.torque"), l.torque)?;
+            for k in 0..3 {
+                ck.finite(&format!("{field}.force[{k}]"), l.force[k])?;
+                ck.finite(&format!("{field}.torque[{k}]"), l.torque[k])?;
+            }
+            if let Some(law) = &l.scale {
+                validate_law(&ck, law, &format!("{field}.scale"))?;
+                if l.input || law.law == "input" {
+                    return Err(ck.fail(
+                        &format!("{field}.scale"),
+                        format!("{:?}", law.law),
+                        "an input load, or an input law, cannot scale a load (use input = true)",
+                    ));
+                }
+            }
         }
-        Ok(())
+        super::space::validate_space(&ck, self)
     }
 
     fn frame_exists(&self, frame: &str) -> bool {
@@ -302,7 +325,7 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError> {
+fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<(), SceneError> {
     let f = |name: &str| format!("beam[{i}].{name}");
     if !is_identifier(&b.name) {
         return Err(ck.fail(
@@ -386,7 +409,9 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError>
     if let Some(g) = b.material.g {
         ck.positive(&f("material.G"), g)?;
     }
-    validate_section(ck, &b.section, &f("section"))?;
+    if b.matrix_text.is_none() {
+        validate_section(ck, &b.section, &f("section"), three)?;
+    }
     ck.non_negative(&f("rayleigh.alpha"), b.rayleigh.alpha)?;
     ck.non_negative(&f("rayleigh.beta"), b.rayleigh.beta)?;
     for (k, p) in b.position.iter().enumerate() {
@@ -408,19 +433,29 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize) -> Result<(), SceneError>
             "needs frame = \"tangent\" (a pinned frame holds the tip on its axis)",
         ));
     }
+    let outputs: &[&str] = if three {
+        &super::BEAM_OUTPUTS_3D
+    } else {
+        &super::BEAM_OUTPUTS
+    };
     for (k, o) in b.outputs.iter().enumerate() {
-        if !BEAM_OUTPUTS.contains(&o.as_str()) {
+        if !outputs.contains(&o.as_str()) {
             return Err(ck.fail(
                 &f(&format!("outputs[{k}]")),
                 format!("{o:?}"),
-                &format!("must be one of {BEAM_OUTPUTS:?}"),
+                &format!("must be one of {outputs:?}"),
             ));
         }
     }
     Ok(())
 }
 
-fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), SceneError> {
+fn validate_section(
+    ck: &Checker,
+    s: &SectionSpec,
+    field: &str,
+    three: bool,
+) -> Result<(), SceneError> {
     let f = |name: &str| format!("{field}.{name}");
     let given = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
         match v {
@@ -437,7 +472,42 @@ fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), Sc
             None => Ok(()),
         }
     };
+    let spatial = [(s.iy, "Iy"), (s.iz, "Iz"), (s.torsion_constant, "It")];
+    if !three {
+        for (v, n) in spatial {
+            unused(
+                v,
+                n,
+                "is for 3D scenes (dimensions = 3); a planar section has A and J",
+            )?;
+        }
+    }
     match s.shape.as_deref() {
+        None if three => {
+            unused(
+                s.second_moment,
+                "J",
+                "is the planar second moment; a 3D section gives Iy, Iz and It",
+            )?;
+            if spatial.iter().all(|(v, _)| v.is_none()) && s.area.is_none() {
+                return Err(ck.fail(
+                    field,
+                    "missing",
+                    "give `A`, `Iy`, `Iz` and `It`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
+                ));
+            }
+            given(s.area, "A")?;
+            for (v, n) in spatial {
+                given(v, n)?;
+            }
+            for (v, n) in [(s.a, "a"), (s.b, "b"), (s.d, "d"), (s.t, "t")] {
+                unused(
+                    v,
+                    n,
+                    "belongs to a `shape`; with the constants given it is not used",
+                )?;
+            }
+        }
         None => {
             if s.area.is_none() && s.second_moment.is_none() {
                 return Err(ck.fail(
@@ -457,7 +527,10 @@ fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), Sc
             }
         }
         Some(shape) => {
-            for (v, n) in [(s.area, "A"), (s.second_moment, "J")] {
+            for (v, n) in [(s.area, "A"), (s.second_moment, "J")]
+                .into_iter()
+                .chain(spatial)
+            {
                 unused(
                     v,
                     n,
@@ -508,13 +581,20 @@ fn validate_section(ck: &Checker, s: &SectionSpec, field: &str) -> Result<(), Sc
     Ok(())
 }
 
-fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize) -> Result<(), SceneError> {
+fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Result<(), SceneError> {
     let f = |name: &str| format!("body[{i}].{name}");
     ck.non_negative(&f("mass"), b.mass)?;
-    ck.non_negative(&f("inertia"), b.inertia)?;
-    for k in 0..2 {
+    for k in 0..3 {
+        ck.non_negative(&f(&format!("inertia[{k}]")), b.inertia[k])?;
         ck.finite(&f(&format!("com[{k}]")), b.com[k])?;
         ck.finite(&f(&format!("position[{k}]")), b.position[k])?;
+    }
+    if three && b.mass > 0.0 && b.inertia.iter().any(|&x| x == 0.0) {
+        return Err(ck.fail(
+            &f("inertia"),
+            format!("{:?}", b.inertia),
+            "a 3D body with mass needs inertia = [Ixx, Iyy, Izz] (principal, body axes), each positive",
+        ));
     }
     ck.finite(&f("angle"), b.angle)?;
     for (name, p) in &b.frames {
@@ -525,13 +605,14 @@ fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize) -> Result<(), SceneE
                 "frame names are identifiers other than a and b",
             ));
         }
-        ck.finite(&f(&format!("frames.{name}[0]")), p[0])?;
-        ck.finite(&f(&format!("frames.{name}[1]")), p[1])?;
+        for k in 0..3 {
+            ck.finite(&f(&format!("frames.{name}[{k}]")), p.0[k])?;
+        }
     }
     Ok(())
 }
 
-fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(), SceneError> {
+pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(), SceneError> {
     let f = |name: &str| format!("{field}.{name}");
     let need = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
         let x = v.ok_or_else(|| {

@@ -75,7 +75,7 @@ pub fn elliptic_k(k: f64) -> f64 {
 
 /// `g` and `L` of the C2 scene: |world.gravity| and the first beam's length.
 fn pendulum(scene: &Scene) -> (f64, f64) {
-    let [gx, gy] = scene.world.gravity;
+    let [gx, gy, _] = scene.world.gravity;
     (gx.hypot(gy), scene.beams[0].length)
 }
 

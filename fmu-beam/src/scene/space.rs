@@ -1,0 +1,214 @@
+//! The rules that depend on a scene's `dimensions`: a planar scene lies in the world x–y plane
+//! and uses no 3D field; a 3D scene's directions are usable, its sections complete, its
+//! matrix files valid, and it asks for planar-only features only when its motion is planar
+//! (then it runs with the planar element, [`Scene::planar_reduction`]).
+
+use super::planar::unit;
+use super::validate::{Checker, SceneError};
+use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
+use crate::beam::matrix_file;
+
+/// Effects a scene run with the 3D element can switch (the others are planar-only).
+pub const SPATIAL_EFFECTS: [&str; 3] = ["gravity", "flexibility", "rayleigh_damping"];
+
+pub(super) fn validate_space(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
+    if s.is_3d() {
+        validate_3d(ck, s)
+    } else {
+        validate_planar(ck, s)
+    }
+}
+
+fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
+    const PLANE: &str = "a planar scene lies in the world x–y plane (z = 0); \
+                         write dimensions = 3 for a 3D scene";
+    const ONLY_3D: &str = "is for 3D scenes (dimensions = 3)";
+    let zero = |field: &str, v: f64, rule: &str| {
+        if v == 0.0 {
+            Ok(())
+        } else {
+            Err(ck.fail(field, v, rule))
+        }
+    };
+    let none = |field: &str, v: bool| {
+        if v {
+            Err(ck.fail(field, "given", ONLY_3D))
+        } else {
+            Ok(())
+        }
+    };
+    if s.formulation != Formulation::Auto {
+        return Err(ck.fail("formulation", "\"spatial\"", ONLY_3D));
+    }
+    zero("world.gravity[2]", s.world.gravity[2], PLANE)?;
+    for (i, b) in s.beams.iter().enumerate() {
+        let f = |n: &str| format!("beam[{i}].{n}");
+        zero(&f("position[2]"), b.position[2], PLANE)?;
+        none(&f("axis"), b.axis.is_some())?;
+        none(&f("normal"), b.normal.is_some())?;
+        none(&f("inertia"), b.inertia != InertiaSpec::Full)?;
+        none(
+            &f("matrix_file"),
+            b.matrix_file.is_some() || b.matrix_text.is_some(),
+        )?;
+    }
+    for (i, b) in s.bodies.iter().enumerate() {
+        let f = |n: &str| format!("body[{i}].{n}");
+        zero(&f("position[2]"), b.position[2], PLANE)?;
+        zero(&f("com[2]"), b.com[2], PLANE)?;
+        for (name, p) in &b.frames {
+            zero(&f(&format!("frames.{name}[2]")), p.0[2], PLANE)?;
+        }
+        for k in 0..2 {
+            zero(
+                &f(&format!("inertia[{k}]")),
+                b.inertia[k],
+                "a planar body has one moment of inertia (about z): give a number",
+            )?;
+        }
+    }
+    for (i, j) in s.joints.iter().enumerate() {
+        let f = |n: &str| format!("joint[{i}].{n}");
+        none(&f("axis"), j.axis.is_some())?;
+        if j.kind == JointKind::Spherical {
+            return Err(ck.fail(&f("type"), "\"spherical\"", ONLY_3D));
+        }
+    }
+    for (i, l) in s.loads.iter().enumerate() {
+        let f = |n: &str| format!("load[{i}].{n}");
+        zero(&f("force[2]"), l.force[2], PLANE)?;
+        for k in 0..2 {
+            zero(
+                &f(&format!("torque[{k}]")),
+                l.torque[k],
+                "a planar torque acts about z: give a number",
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// A finite, non-zero direction.
+fn direction(ck: &Checker, field: &str, v: [f64; 3]) -> Result<[f64; 3], SceneError> {
+    for (k, x) in v.iter().enumerate() {
+        ck.finite(&format!("{field}[{k}]"), *x)?;
+    }
+    unit(v).ok_or_else(|| ck.fail(field, format!("{v:?}"), "must be a non-zero direction"))
+}
+
+fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
+    // why the planar element cannot be used, if it cannot
+    let spatial = s.planar_reduction().err();
+    let planar_only = |field: &str, value: String, what: &str| -> Result<(), SceneError> {
+        match &spatial {
+            Some(why) => Err(ck.fail(
+                field,
+                value,
+                &format!(
+                    "{what} is available with the planar element only, and this scene runs \
+                     with the 3D element ({why})"
+                ),
+            )),
+            None => Ok(()),
+        }
+    };
+    for (i, b) in s.beams.iter().enumerate() {
+        let f = |n: &str| format!("beam[{i}].{n}");
+        let axis = match b.axis {
+            Some(a) => direction(ck, &f("axis"), a)?,
+            None => [b.angle.cos(), b.angle.sin(), 0.0],
+        };
+        if let Some(n) = b.normal {
+            let n = direction(ck, &f("normal"), n)?;
+            let dot = axis[0] * n[0] + axis[1] * n[1] + axis[2] * n[2];
+            if dot.abs() > 1e-9 {
+                return Err(ck.fail(
+                    &f("normal"),
+                    format!("{n:?}"),
+                    "must be normal to the beam axis (it is the section's local z axis)",
+                ));
+            }
+        } else if axis[2].abs() > 1e-9 {
+            return Err(ck.fail(
+                &f("normal"),
+                "missing",
+                "is required when the beam axis leaves the x–y plane (the default is world z)",
+            ));
+        }
+        if !b.rigid && b.matrix_text.is_none() && b.material.g.is_none() {
+            return Err(ck.fail(
+                &f("material.G"),
+                "missing",
+                "a flexible 3D beam needs its shear modulus (torsion)",
+            ));
+        }
+        if b.modes.is_some() {
+            planar_only(&f("modes"), format!("{:?}", b.modes), "modal truncation")?;
+        }
+        if b.geometric_stiffening {
+            planar_only(
+                &f("geometric_stiffening"),
+                "true".into(),
+                "geometric stiffening",
+            )?;
+        }
+        if b.initial.tip_displacement != 0.0 {
+            planar_only(
+                &f("initial.tip_displacement"),
+                b.initial.tip_displacement.to_string(),
+                "an initial static deflection",
+            )?;
+        }
+        if let Some(text) = &b.matrix_text {
+            let file = b
+                .matrix_file
+                .clone()
+                .unwrap_or_else(|| "matrix_text".into());
+            let m = matrix_file::parse(text, &file)
+                .map_err(|e| ck.fail(&f("matrix_file"), format!("{file:?}"), &e.to_string()))?;
+            if b.rigid || b.elements != Some(1) {
+                return Err(ck.fail(
+                    &f("matrix_file"),
+                    format!("{file:?}"),
+                    "a matrix-file beam is one flexible element: write elements = 1, no \
+                     substructures, not rigid",
+                ));
+            }
+            if (m.length - b.length).abs() > 1e-9 * b.length {
+                return Err(ck.fail(
+                    &f("length"),
+                    b.length,
+                    &format!("must equal the matrix file's length {}", m.length),
+                ));
+            }
+        }
+    }
+    for (i, j) in s.joints.iter().enumerate() {
+        let f = |n: &str| format!("joint[{i}].{n}");
+        if let Some(a) = j.axis {
+            direction(ck, &f("axis"), a)?;
+        }
+        if j.kind == JointKind::Spherical && j.drive.is_some() {
+            return Err(ck.fail(
+                &f("drive"),
+                "given",
+                "a spherical joint has no single coordinate to drive",
+            ));
+        }
+    }
+    if let (Some(why), EffectsSpec::List(names)) = (&spatial, &s.effects) {
+        for (k, n) in names.iter().enumerate() {
+            if !SPATIAL_EFFECTS.contains(&n.as_str()) {
+                return Err(ck.fail(
+                    &format!("effects[{k}]"),
+                    format!("{n:?}"),
+                    &format!(
+                        "with the 3D element ({why}) the effects that can be switched are {}",
+                        SPATIAL_EFFECTS.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}

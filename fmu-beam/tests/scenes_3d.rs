@@ -1,0 +1,291 @@
+//! 3D scene files (issue 4, items 3–5): what `dimensions = 3` accepts and refuses, the rule
+//! that a 3D scene whose motion is planar runs with the planar element, the fast variants as
+//! scenes (frozen inertia, a matrix file) against the full model, and the canonical text.
+
+mod common;
+
+use common::{run, scene, vr};
+use fmu_beam::beam::matrix_file::MatrixFile;
+use fmu_beam::beam::spatial_element;
+use fmu_beam::beam::spatial_section::SpatialSection;
+use fmu_beam::{Engine, Scene};
+use nalgebra::DMatrix;
+use std::path::Path;
+
+const SCENES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes");
+
+/// The text of the C6 beam's own one-element matrices (L = 0.2 m, C5's section).
+fn c6_element_text() -> String {
+    let s = SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7);
+    let (rho, e, g, l) = (7800.0, 210e9, 8.077e10, 0.2);
+    let m = spatial_element::mass(rho * s.area, rho * s.polar_moment, l);
+    let k = spatial_element::stiffness(e * s.area, g * s.torsion_constant, e * s.iy, e * s.iz, l);
+    let to = |a: [[f64; 12]; 12]| DMatrix::from_fn(12, 12, |i, j| a[i][j]);
+    MatrixFile {
+        length: l,
+        mass: to(m),
+        stiffness: to(k),
+    }
+    .to_text(
+        "C6 beam (L = 0.2 m, rho 7800, E 210e9, G 8.077e10, C5's section), one Euler-Bernoulli \
+         element; written by fmu-beam/tests/scenes_3d.rs (UPDATE_MATRICES=1)",
+    )
+}
+
+/// The scene's matrix file is the C6 element's own matrices (regenerate with
+/// UPDATE_MATRICES=1).
+#[test]
+fn the_matrix_file_scene_holds_the_c6_element() {
+    let path = Path::new(SCENES).join("matrices/pendulum_3d_element.txt");
+    let text = c6_element_text();
+    if std::env::var_os("UPDATE_MATRICES").is_some() {
+        std::fs::write(&path, &text).expect("write the matrix file");
+    }
+    let file = std::fs::read_to_string(&path).expect("matrix file exists");
+    assert_eq!(file, text, "{} is stale: UPDATE_MATRICES=1", path.display());
+}
+
+fn refused(text: &str) -> String {
+    match Scene::from_toml_str(text, "t.toml") {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const PLANAR: &str = "name = \"p\"\n[[beam]]\nname = \"beam\"\nlength = 1.0\nelements = 2\n\
+    material = { rho = 7800.0, E = 2e11 }\nsection = { A = 1e-4, J = 1e-9 }\n";
+const SPATIAL: &str = "name = \"s\"\ndimensions = 3\n[[beam]]\nname = \"beam\"\nlength = 1.0\n\
+    elements = 2\nmaterial = { rho = 7800.0, E = 2e11, G = 8e10 }\n\
+    section = { A = 1e-4, Iy = 2e-9, Iz = 1e-9, It = 1.5e-9 }\n";
+
+#[test]
+fn scene_rules_of_each_dimension_name_the_field() {
+    assert!(Scene::from_toml_str(PLANAR, "t").is_ok());
+    assert!(Scene::from_toml_str(SPATIAL, "t").is_ok());
+    let cases: [(String, &str, &str); 11] = [
+        (
+            PLANAR.replace(
+                "name = \"p\"\n",
+                "name = \"p\"\n[world]\ngravity = [0, 0, -9.81]\n",
+            ),
+            "world.gravity[2]",
+            "x–y plane",
+        ),
+        (
+            PLANAR.replace("elements = 2\n", "elements = 2\naxis = [0, 1, 0]\n"),
+            "beam[0].axis",
+            "3D scenes",
+        ),
+        (
+            PLANAR.replace("J = 1e-9", "J = 1e-9, Iy = 1e-9"),
+            "beam[0].section.Iy",
+            "3D scenes",
+        ),
+        (
+            SPATIAL.replace("Iy = 2e-9, ", ""),
+            "beam[0].section.Iy",
+            "required",
+        ),
+        (
+            SPATIAL.replace("It = 1.5e-9", "It = 1.5e-9, J = 1e-9"),
+            "beam[0].section.J",
+            "Iy, Iz and It",
+        ),
+        (
+            SPATIAL.replace(", G = 8e10", ""),
+            "beam[0].material.G",
+            "shear modulus",
+        ),
+        (
+            SPATIAL.replace(
+                "elements = 2\n",
+                "elements = 2\naxis = [1, 0, 0]\nnormal = [1, 0, 1]\n",
+            ),
+            "beam[0].normal",
+            "normal to the beam axis",
+        ),
+        (
+            SPATIAL.replace("elements = 2\n", "elements = 2\naxis = [0, 0, 0]\n"),
+            "beam[0].axis",
+            "non-zero direction",
+        ),
+        (
+            format!(
+                "{SPATIAL}[[joint]]\nname = \"j\"\ntype = \"spherical\"\nframes = [\"world\", \
+                 \"beam.a\"]\ndrive = {{ kind = \"motion\", law = \"constant\", value = 1.0 }}\n"
+            ),
+            "joint[0].drive",
+            "spherical",
+        ),
+        (
+            format!("{SPATIAL}geometric_stiffening = true\n[world]\ngravity = [0, 0, -9.81]\n"),
+            "beam[0].geometric_stiffening",
+            "planar element only",
+        ),
+        (
+            format!(
+                "{SPATIAL}[[load]]\nname = \"l\"\nframe = \"beam.b\"\ninput = true\n\
+                 scale = {{ law = \"table\", table = [[0, 0], [1, 1]] }}\n"
+            ),
+            "load[0].scale",
+            "input",
+        ),
+    ];
+    for (text, field, rule) in cases {
+        let msg = refused(&text);
+        println!("{msg}");
+        assert!(msg.contains(&format!("`{field}`")), "{msg}");
+        assert!(msg.contains(rule), "{msg}");
+    }
+    // a planar torque is a number; a vector with an in-plane part is refused
+    let msg = refused(&format!(
+        "{PLANAR}[[load]]\nname = \"l\"\nframe = \"beam.b\"\ntorque = [1, 0, 0]\n"
+    ));
+    assert!(msg.contains("load[0].torque[0]"), "{msg}");
+}
+
+#[test]
+fn a_bad_matrix_file_is_refused_with_its_line_and_rule() {
+    let good = c6_element_text();
+    let scene = |text: &str| {
+        format!(
+            "name = \"m\"\ndimensions = 3\n[[beam]]\nname = \"beam\"\nlength = 0.2\n\
+             elements = 1\nmatrix_file = \"e.txt\"\nmatrix_text = '''\n{text}'''\n\
+             material = {{ rho = 7800.0, E = 2e11 }}\n"
+        )
+    };
+    assert!(Scene::from_toml_str(&scene(&good), "t").is_ok());
+    // one mass entry made unsymmetric
+    let lines: Vec<&str> = good.lines().collect();
+    let at = lines.iter().position(|l| l.starts_with("mass")).unwrap() + 1;
+    let mut row: Vec<String> = lines[at].split_whitespace().map(String::from).collect();
+    row[1] = "1.0".into();
+    let mut bad: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
+    bad[at] = row.join(" ");
+    let msg = refused(&scene(&(bad.join("\n") + "\n")));
+    println!("{msg}");
+    assert!(
+        msg.contains("`beam[0].matrix_file`") && msg.contains("e.txt"),
+        "{msg}"
+    );
+    assert!(msg.contains("symmetric"), "{msg}");
+    // the scene's length must be the file's
+    let msg = refused(&scene(&good).replace("length = 0.2", "length = 0.3"));
+    assert!(
+        msg.contains("beam[0].length") && msg.contains("0.2"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn a_3d_scene_whose_motion_is_planar_reduces_to_the_planar_element() {
+    let z = scene("rollup_3d_z.toml");
+    let planar = z.planar_reduction().expect("rolls up in the x-y plane");
+    assert_eq!(planar.dimensions, 2);
+    assert_eq!(planar.beams[0].section.second_moment, Some(4.19e-8));
+    for (file, why) in [
+        ("rollup_3d.toml", "torque about an in-plane axis"),
+        ("pendulum_3d.toml", "gravity has a z component"),
+        ("pendulum_3d_frozen.toml", "gravity has a z component"),
+    ] {
+        let e = scene(file).planar_reduction().unwrap_err();
+        assert!(e.contains(why), "{file}: {e}");
+    }
+    // a planar scene written in 3D form: same model, same numbers
+    let planar_text = std::fs::read_to_string(Path::new(SCENES).join("flexible_pendulum.toml"))
+        .unwrap()
+        .replace("gravity = [0.0, -9.81]", "gravity = [0.0, -9.81, 0.0]")
+        .replace(
+            "section = { A = 0.0018, J = 1.215e-8 }",
+            "section = { A = 0.0018, Iy = 1e-8, Iz = 1.215e-8, It = 1e-8 }\naxis = [1.0, 0.0, 0.0]",
+        )
+        .replace(
+            "material = { rho = 5540.0, E = 1e9 }",
+            "material = { rho = 5540.0, E = 1e9, G = 4e8 }",
+        )
+        .replace(
+            "name = \"flexible_pendulum\"",
+            "name = \"flexible_pendulum\"\ndimensions = 3",
+        );
+    let as_3d = Scene::from_toml_str(&planar_text, "3d.toml").expect("valid 3D scene");
+    let two = run(
+        scene("flexible_pendulum.toml"),
+        &[],
+        &["beam.tip.x", "beam.tip.y"],
+        0.05,
+        0.3,
+    );
+    let three = run(
+        as_3d,
+        &[],
+        &["beam.tip.x", "beam.tip.y", "beam.tip.z"],
+        0.05,
+        0.3,
+    );
+    for (a, b) in two.rows.iter().zip(&three.rows) {
+        assert_eq!(a[1], b[1]);
+        assert_eq!(a[2], b[2]);
+        assert_eq!(b[3], 0.0);
+    }
+}
+
+/// Fixed steps of 2e-4 s for the variant comparison: every model then carries nearly the same
+/// time-discretization error, so the differences are the models' own.
+const FIXED: [(&str, f64); 3] = [
+    ("solver.adaptive", 0.0),
+    ("solver.max_step", 2e-4),
+    ("solver.tolerance", 1e-10),
+];
+
+/// Hinge angle of a C6 scene at 1 s and the wall time of the run.
+fn c6_angle(s: Scene) -> (f64, f64) {
+    let t0 = std::time::Instant::now();
+    let r = run(s, &FIXED, &["hinge.angle"], 0.01, 1.0);
+    (r.last(1), t0.elapsed().as_secs_f64())
+}
+
+/// The fast variants as scenes: the matrix-file beam (the element's own matrices) equals the
+/// frozen one-element beam to 1e-9 rad, and frozen inertia stays within 1e-5 rad of the full
+/// model on C6 at 1 s: below the flexibility's own effect (the lag of 2.4e-6 s is 2.3e-5 rad),
+/// so the variant keeps what the flexible model is for. Times are one run each; `make bench`
+/// has the repeated measurement.
+#[test]
+fn fast_variant_scenes_match_the_full_model() {
+    let (full, t_full) = c6_angle(scene("pendulum_3d.toml"));
+    let (frozen, t_frozen) = c6_angle(scene("pendulum_3d_frozen.toml"));
+    let (matrix, t_matrix) = c6_angle(scene("pendulum_3d_matrix.toml"));
+    let mut one = scene("pendulum_3d_frozen.toml");
+    one.beams[0].elements = Some(1);
+    let (one_el, t_one) = c6_angle(one);
+    println!(
+        "C6 hinge angle at 1 s (fixed step 2e-4 s): full {full:.9} ({t_full:.2} s), frozen \
+         {frozen:.9} ({t_frozen:.2} s, error {:.1e}), matrix file {matrix:.9} ({t_matrix:.2} s), \
+         frozen 1 element {one_el:.9} ({t_one:.2} s, error {:.1e})",
+        frozen - full,
+        one_el - full
+    );
+    assert!((matrix - one_el).abs() < 1e-9, "{matrix} vs {one_el}");
+    assert!((frozen - full).abs() < 1e-5, "{frozen} vs {full}");
+}
+
+/// A 3D scene's canonical text (what the FMU carries) reads back to the same scene, matrix
+/// text included; parameters of a 3D scene reach the model.
+#[test]
+fn the_canonical_text_of_a_3d_scene_round_trips() {
+    for file in [
+        "rollup_3d.toml",
+        "pendulum_3d_matrix.toml",
+        "pendulum_3d_rigid.toml",
+    ] {
+        let s = scene(file);
+        let back = Scene::from_toml_str(&s.to_toml_string(), file).expect("reads back");
+        assert_eq!(back, s, "{file}");
+    }
+    let mut e = Engine::new(scene("pendulum_3d.toml"));
+    let g = vr(&e, "world.gravity.z");
+    e.set_real(g, 0.0).unwrap();
+    e.exit_initialization().unwrap();
+    e.do_step(0.0, 0.1).unwrap();
+    let angle = e.get_real(vr(&e, "hinge.angle")).unwrap();
+    assert_eq!(angle, 0.0, "without gravity the pendulum stays");
+}
