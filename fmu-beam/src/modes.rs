@@ -3,18 +3,18 @@
 
 use crate::error::EngineError;
 use crate::integrator::{initial_state, Settings};
-use crate::multibody::System;
+use crate::mechanics::Mechanics;
+use crate::multibody::equations::Equations;
 use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector};
 
 /// Natural frequencies (Hz), ascending, of the scene linearized about its initial
-/// configuration at rest (deformation and loads as at t = 0).
+/// configuration at rest (deformation and loads as at t = 0). A 3D scene is linearized with
+/// the element it runs with (planar when its motion is planar).
 pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
-    let sys = System::from_scene(scene);
     let settings = Settings::from_scene(scene);
-    let mut st = initial_state(&sys, scene, 0.0, &settings)?;
     // linearize about the undeformed equilibrium of the free motions
-    st.q = sys.initial_coordinates(&Scene {
+    let undeformed = Scene {
         beams: scene
             .beams
             .iter()
@@ -25,16 +25,29 @@ pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
             })
             .collect(),
         ..scene.clone()
-    })?;
+    };
+    let effects = crate::effects::resolve(scene).effects;
+    let sys = Mechanics::build(scene, &effects);
+    let st = initial_state(&sys, scene, 0.0, &settings)?;
+    let q = Mechanics::build(&undeformed, &effects).initial_coordinates(&undeformed)?;
+    linearized(&sys, &q, &st.lambda)
+}
+
+/// Frequencies of K φ = ω² M φ at q (at rest) on the null space of G.
+fn linearized<E: Equations>(
+    sys: &E,
+    q: &DVector<f64>,
+    lambda: &DVector<f64>,
+) -> Result<Vec<f64>, EngineError> {
     let (n, m) = (sys.n(), sys.m());
     let zero = DVector::zeros(n);
     let mut mm = DMatrix::zeros(n, n);
     let mut kt = DMatrix::zeros(n, n);
     let mut ct = DMatrix::zeros(n, n);
     let mut gm = DMatrix::zeros(m, n);
-    sys.mass_matrix(&st.q, &mut mm);
-    sys.tangents(&st.q, &zero, &zero, &st.lambda, 0.0, &mut kt, &mut ct);
-    sys.constraint_jacobian(&st.q, 0.0, &mut gm);
+    sys.mass_matrix(q, &mut mm);
+    sys.tangents(q, &zero, &zero, lambda, 0.0, &mut kt, &mut ct);
+    sys.constraint_jacobian(q, 0.0, &mut gm);
     let basis = null_space(&gm, n);
     let mr = basis.transpose() * &mm * &basis;
     let kr = basis.transpose() * &kt * &basis;
