@@ -116,6 +116,15 @@ impl Resolution {
                 d.why
             );
         }
+        let spatial = self
+            .decisions
+            .iter()
+            .any(|d| d.effect == "formulation" && d.setting == "spatial");
+        if spatial {
+            s += "\ncost: no operation-count model for the 3D element (shares shown as 0); \
+                  `make bench` measures the time.\n";
+            return s;
+        }
         s += &format!(
             "\ncost: the share of the operations of one step (residual, tangents, LU of the \
              iteration matrix) that the effect adds, from an operation count of the resolved \
