@@ -335,16 +335,16 @@ pub fn resolve(scene: &Scene) -> Resolution {
 /// cost model (cost shares 0).
 fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
     use crate::scene::EffectsSpec;
-    let (mode, on): (&'static str, Box<dyn Fn(&str) -> Option<bool>>) = match &scene.effects {
-        EffectsSpec::List(names) => {
-            let names = names.clone();
-            (
-                "list",
-                Box::new(move |e| Some(names.iter().any(|n| n == e))),
-            )
-        }
-        EffectsSpec::Mode(m) if m == "auto" => ("auto", Box::new(|_| None)),
-        EffectsSpec::Mode(_) => ("all", Box::new(|_| Some(true))),
+    // what the mode settles itself (None: auto decides)
+    let (mode, listed): (&'static str, &[String]) = match &scene.effects {
+        EffectsSpec::List(names) => ("list", names),
+        EffectsSpec::Mode(m) if m == "auto" => ("auto", &[]),
+        EffectsSpec::Mode(_) => ("all", &[]),
+    };
+    let on = |e: &str| match mode {
+        "list" => Some(listed.iter().any(|n| n == e)),
+        "all" => Some(true),
+        _ => None,
     };
     let reason = |auto: &str| match mode {
         "list" => "listed in `effects`".to_string(),
@@ -364,7 +364,7 @@ fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
         Decision {
             effect: "gravity",
             subject: "scene".into(),
-            setting: on_off(gravity).into(),
+            setting: on_off(gravity),
             why: reason(if field {
                 "a gravity field"
             } else {
@@ -381,7 +381,7 @@ fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
         decisions.push(Decision {
             effect: "flexibility",
             subject: b.name.clone(),
-            setting: on_off(!rigid).into(),
+            setting: on_off(!rigid),
             why: if b.rigid {
                 "the scene makes the beam rigid (rigid = true)".into()
             } else {
@@ -393,7 +393,7 @@ fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
             decisions.push(Decision {
                 effect: "rayleigh_damping",
                 subject: b.name.clone(),
-                setting: on_off(damping).into(),
+                setting: on_off(damping),
                 why: reason(if damped {
                     "damping coefficients given"
                 } else {

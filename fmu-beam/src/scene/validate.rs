@@ -589,7 +589,7 @@ fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Resu
         ck.finite(&f(&format!("com[{k}]")), b.com[k])?;
         ck.finite(&f(&format!("position[{k}]")), b.position[k])?;
     }
-    if three && b.mass > 0.0 && b.inertia.iter().any(|&x| x == 0.0) {
+    if three && b.mass > 0.0 && b.inertia.contains(&0.0) {
         return Err(ck.fail(
             &f("inertia"),
             format!("{:?}", b.inertia),
