@@ -377,3 +377,31 @@ fn a_3d_cantilever_under_input_loads_deflects_and_twists_as_beam_theory_says() {
     // the deflection (twist × deflection_z = 2.3e-8 m here)
     assert!(dy.abs() < 2.0 * twist * dz.abs(), "{dy}");
 }
+
+/// Effects of 3D scenes: the element is a decision with its reason; a scene run with the 3D
+/// element switches gravity, flexibility and damping (terms off are not computed: no gravity,
+/// no swing) and refuses a planar-only effect by name.
+#[test]
+fn effects_of_3d_scenes_say_which_element_runs() {
+    let first = |file: &str| {
+        let r = fmu_beam::effects::resolve(&scene(file));
+        let d = &r.decisions[0];
+        (d.effect, d.setting.clone())
+    };
+    assert_eq!(first("rollup_3d_z.toml"), ("formulation", "planar".into()));
+    assert_eq!(first("rollup_3d.toml"), ("formulation", "spatial".into()));
+    let mut s = scene("pendulum_3d.toml");
+    s.effects = fmu_beam::scene::EffectsSpec::List(vec!["flexibility".into()]);
+    let text = s.to_toml_string();
+    let s = Scene::from_toml_str(&text, "no_gravity.toml").expect("valid");
+    let mut e = Engine::new(s.clone());
+    assert!(e.variables().by_name("world.gravity.z").is_none());
+    e.exit_initialization().unwrap();
+    e.do_step(0.0, 0.1).unwrap();
+    assert_eq!(e.get_real(vr(&e, "hinge.angle")).unwrap(), 0.0);
+    let msg = refused(&text.replace("\"flexibility\"", "\"flexibility\", \"axial\""));
+    assert!(
+        msg.contains("effects[1]") && msg.contains("3D element"),
+        "{msg}"
+    );
+}
