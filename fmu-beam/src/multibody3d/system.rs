@@ -234,6 +234,15 @@ impl System3 {
         self.loads.push(load);
     }
 
+    /// Sets the initial deformation coordinates q_f of body `body` (part of the placement
+    /// before assembly, zero unless set), e.g. a static deflected shape.
+    pub fn set_initial_deformation(&mut self, body: usize, qf: &[f64]) {
+        let nf = self.bodies[body].nflex();
+        assert_eq!(qf.len(), nf, "body {body} has {nf} deformation coordinates");
+        let o = self.offsets[body] + FRAME;
+        self.initial[o..o + nf].copy_from_slice(qf);
+    }
+
     /// Coordinates of body `i`.
     pub fn body_coords<'a>(&self, i: usize, q: &'a DVector<f64>) -> DVectorView<'a, f64> {
         q.rows(self.offsets[i], self.bodies[i].ncoords())
