@@ -59,7 +59,8 @@ check:
 	$(MAKE) test
 
 # Work-precision study (fmu-harness work-precision): every case C1-C4 over formulations, integrator
-# settings and effects; build/bench/REPORT.md, points.csv, <case>.png, and the README's chart.
+# settings and effects, then the 3D section (C5, C6, the fast variants; `--cases 3D` runs it alone);
+# build/bench/REPORT.md, points.csv, <case>.png, and the README's chart.
 # (tests/bench_c1.py, C1 timed through fmpy, runs by hand: $(PY) tests/bench_c1.py)
 bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench

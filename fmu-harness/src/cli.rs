@@ -91,7 +91,8 @@ pub enum Command {
         /// and integrator mode are skipped.
         #[arg(long, default_value_t = 2.5)]
         budget: f64,
-        /// Only these cases (C1, C2, C3, C4).
+        /// Only these cases: C1, C2, C3, C4 (planar), C5, C6, F3 (3D: the roll-up, the
+        /// pendulum, the fast variants), or 3D for all three.
         #[arg(long, value_delimiter = ',')]
         cases: Vec<String>,
     },
@@ -125,16 +126,36 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             budget,
             cases,
         } => {
+            let wanted = |name: &str| {
+                cases.is_empty()
+                    || cases.iter().any(|n| {
+                        n == name || (n == "3D" && work_precision::spatial::NAMES.contains(&name))
+                    })
+            };
             let chosen: Vec<_> = work_precision::cases::cases()
                 .into_iter()
-                .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
+                .filter(|c| wanted(c.name))
+                .collect();
+            let spatial: Vec<&str> = work_precision::spatial::NAMES
+                .into_iter()
+                .filter(|n| wanted(n))
                 .collect();
             let options = work_precision::Options { repeats, budget };
             let started = std::time::Instant::now();
-            let results =
-                work_precision::study(&scenes, &chosen, &options, &mut |line| eprintln!("{line}"))?;
+            let mut progress = |line: &str| eprintln!("{line}");
+            let results = work_precision::study(&scenes, &chosen, &options, &mut progress)?;
+            let spatial = if spatial.is_empty() {
+                None
+            } else {
+                Some(work_precision::spatial::study(
+                    &spatial,
+                    &options,
+                    &mut progress,
+                )?)
+            };
             let header = work_precision::header(&options, started.elapsed().as_secs_f64());
-            for path in work_precision::report::write(&output, &results, &header)? {
+            for path in work_precision::report::write(&output, &results, spatial.as_ref(), &header)?
+            {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
             }
         }

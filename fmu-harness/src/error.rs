@@ -43,6 +43,8 @@ pub enum HarnessError {
     #[error("scene `{scene}`: its canonical text for resources/scene.toml is unusable: {message}")]
     CanonicalScene { scene: String, message: String },
     #[error(transparent)]
+    MatrixFile(#[from] fmu_beam::beam::matrix_file::MatrixFileError),
+    #[error(transparent)]
     Simulate(#[from] crate::simulate::SimulateError),
     #[error(transparent)]
     Cosim(#[from] crate::cosim::CosimError),

@@ -7,11 +7,12 @@
 //! switched off in turn, and `effects = "auto"`. Runs the engine directly (no FMI layer),
 //! `repeats` times per point, and reports the CPU time of the thread (the scheduler's account
 //! in /proc; wall time where Linux does not offer it) as median / min / max. [`report`] writes
-//! `points.csv` and `REPORT.md`.
+//! `points.csv` and `REPORT.md`. [`spatial`] adds the 3D cases, built in code.
 
 pub mod cases;
 pub mod exact;
 pub mod report;
+pub mod spatial;
 
 use crate::error::HarnessError;
 use cases::{Case, Formulation, Reference};
@@ -221,9 +222,12 @@ fn clock(start: Instant) -> f64 {
 /// shorter than this are timed in batches and the batch's time divided by its size.
 pub const MIN_SAMPLE: f64 = 0.1;
 
+/// One run of a model: its outputs, counters and CPU seconds.
+type Run<'a> = dyn Fn() -> Result<Series, EngineError> + 'a;
+
 /// A model being timed: its first run's results, the batch size and the samples so far.
 struct Timing<'a> {
-    scene: &'a Scene,
+    run: &'a Run<'a>,
     first: Series,
     n: usize,
     samples: Vec<f64>,
@@ -231,10 +235,10 @@ struct Timing<'a> {
 
 impl<'a> Timing<'a> {
     /// Runs the model once, and sizes the batch of runs one sample takes (≥ MIN_SAMPLE s).
-    fn start(scene: &'a Scene, case: &Case) -> Result<Timing<'a>, EngineError> {
-        let first = simulate(scene, case)?;
+    fn start(run: &'a Run<'a>) -> Result<Timing<'a>, EngineError> {
+        let first = run()?;
         let mut t = Timing {
-            scene,
+            run,
             first,
             n: 1,
             samples: Vec::new(),
@@ -249,7 +253,7 @@ impl<'a> Timing<'a> {
             // double the batch until it lasts MIN_SAMPLE; that batch is the first sample
             loop {
                 t.n *= 2;
-                let total = t.batch(case)?;
+                let total = t.batch()?;
                 if total >= MIN_SAMPLE || t.n >= 1 << 16 {
                     t.samples.push(total / t.n as f64);
                     break;
@@ -260,18 +264,18 @@ impl<'a> Timing<'a> {
     }
 
     /// CPU seconds of a batch of `n` runs.
-    fn batch(&self, case: &Case) -> Result<f64, EngineError> {
+    fn batch(&self) -> Result<f64, EngineError> {
         let origin = Instant::now();
         let c0 = clock(origin);
         for _ in 0..self.n {
-            simulate(self.scene, case)?;
+            (self.run)()?;
         }
         Ok(clock(origin) - c0)
     }
 
     /// One more sample: a batch's time over its size.
-    fn sample(&mut self, case: &Case) -> Result<(), EngineError> {
-        let t = self.batch(case)?;
+    fn sample(&mut self) -> Result<(), EngineError> {
+        let t = self.batch()?;
         self.samples.push(t / self.n as f64);
         Ok(())
     }
@@ -290,23 +294,23 @@ impl<'a> Timing<'a> {
 type Timed = Result<(Series, [f64; 3], usize), EngineError>;
 
 /// Times one model: `repeats` samples.
-fn timed(scene: &Scene, case: &Case, repeats: usize) -> Timed {
-    let mut t = Timing::start(scene, case)?;
+fn timed(run: &Run, repeats: usize) -> Timed {
+    let mut t = Timing::start(run)?;
     while t.samples.len() < repeats.max(1) {
-        t.sample(case)?;
+        t.sample()?;
     }
     Ok(t.finish())
 }
 
 /// Times several models round by round (one sample of each per round), so that a change of
 /// the machine's load during the measurement falls on all of them alike.
-fn timed_together<'a>(scenes: &[&'a Scene], case: &Case, repeats: usize) -> Vec<Timed> {
+fn timed_together<'a>(runs: &[&'a Run<'a>], repeats: usize) -> Vec<Timed> {
     let mut ts: Vec<Result<Timing<'a>, EngineError>> =
-        scenes.iter().map(|s| Timing::start(s, case)).collect();
+        runs.iter().map(|r| Timing::start(*r)).collect();
     for _ in 0..repeats.max(1) {
         for t in &mut ts {
             let failed = match t {
-                Ok(x) if x.samples.len() < repeats.max(1) => x.sample(case).err(),
+                Ok(x) if x.samples.len() < repeats.max(1) => x.sample().err(),
                 _ => None,
             };
             if let Some(e) = failed {
@@ -479,7 +483,7 @@ pub fn study(
                 } else {
                     let scene = build(&base, case, f, setting, EffectsSpec::default())?;
                     let mut p = skeleton(case, f.name, setting);
-                    score(&mut p, timed(&scene, case, options.repeats));
+                    score(&mut p, timed(&|| simulate(&scene, case), options.repeats));
                     if p.ok() && p.seconds[0] > options.budget {
                         over.push(setting.mode());
                     }
@@ -525,9 +529,14 @@ pub fn study(
                 row("auto".into(), None, auto_differs(&full, &auto)),
                 Ok(auto_scene),
             ));
-            let runnable: Vec<&Scene> = rows.iter().filter_map(|(_, s)| s.as_ref().ok()).collect();
+            let runs: Vec<_> = rows
+                .iter()
+                .filter_map(|(_, s)| s.as_ref().ok())
+                .map(|s| move || simulate(s, case))
+                .collect();
+            let runnable: Vec<&Run> = runs.iter().map(|r| r as &Run).collect();
             let repeats = options.repeats.max(EFFECTS_REPEATS);
-            let mut timings = timed_together(&runnable, case, repeats).into_iter();
+            let mut timings = timed_together(&runnable, repeats).into_iter();
             let rows: Vec<EffectRow> = rows
                 .into_iter()
                 .map(|(mut r, scene)| {

@@ -1,8 +1,9 @@
 //! The study's outputs: `points.csv` (every point, read by `tests/plot_work_precision.py` for
 //! the `<case>.png` charts) and `REPORT.md` (per case: the reference, the chart, the sweep
-//! table, the cheapest run to a given accuracy per formulation, the effects tables).
+//! table, the cheapest run to a given accuracy per formulation, the effects tables), then the
+//! 3D section of [`spatial`].
 
-use super::{CaseResult, EffectRow, Point, Status};
+use super::{spatial, CaseResult, EffectRow, Point, Status};
 use crate::error::HarnessError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -22,8 +23,8 @@ fn status_text(s: &Status) -> (&'static str, &str) {
     }
 }
 
-/// Every point of every case, one row each (`kind` = sweep or effects).
-pub fn csv(results: &[CaseResult]) -> String {
+/// Every point of every case, one row each (`kind` = sweep, effects or variants).
+pub fn csv(results: &[CaseResult], spatial: Option<&spatial::Results>) -> String {
     let mut s = String::from(
         "case,kind,formulation,effects,mode,setting,status,runs,cpu_seconds_median,cpu_seconds_min,\
          cpu_seconds_max,steps,newton_iterations,factorizations,output,error_max,error_relative,message\n",
@@ -61,6 +62,9 @@ pub fn csv(results: &[CaseResult]) -> String {
             }
         }
     }
+    if let Some(r) = spatial {
+        spatial::csv_rows(r, &mut row);
+    }
     s
 }
 
@@ -73,7 +77,7 @@ pub fn sig3(x: f64) -> String {
     format!("{x:.decimals$}")
 }
 
-fn cpu(p: &Point) -> String {
+pub(super) fn cpu(p: &Point) -> String {
     format!(
         "{} ({}–{})",
         sig3(p.seconds[0]),
@@ -82,7 +86,7 @@ fn cpu(p: &Point) -> String {
     )
 }
 
-fn sci(x: f64) -> String {
+pub(super) fn sci(x: f64) -> String {
     if x.is_nan() {
         "–".into()
     } else {
@@ -91,25 +95,30 @@ fn sci(x: f64) -> String {
 }
 
 fn sweep_table(r: &CaseResult) -> String {
-    let c = &r.case;
+    points_table(r.case.outputs, r.check.is_some(), &r.points)
+}
+
+/// Every point of a sweep: error of each of `outputs`, the check's column if `check`, time
+/// and counters.
+pub(super) fn points_table(outputs: &[&str], check: bool, points: &[Point]) -> String {
     let mut s = String::from("| formulation | integrator | ");
-    let _ = write!(s, "error `{}` (relative)", c.outputs[0]);
-    for o in &c.outputs[1..] {
+    let _ = write!(s, "error `{}` (relative)", outputs[0]);
+    for o in &outputs[1..] {
         let _ = write!(s, " | relative error `{o}`");
     }
-    if r.check.is_some() {
+    if check {
         s += " | error vs exact rigid";
     }
     s += " | CPU s median (min–max) | steps | Newton | LU |\n|---|---|---|";
-    s += &"---|".repeat(c.outputs.len() - 1 + usize::from(r.check.is_some()));
+    s += &"---|".repeat(outputs.len() - 1 + usize::from(check));
     s += "---|---|---|---|\n";
-    for p in &r.points {
+    for p in points {
         let _ = write!(s, "| {} | {} |", p.formulation, p.setting);
         match &p.status {
             Status::Ok => {
                 let _ = write!(s, " {} ({}) |", sci(p.errors[0]), sci(p.relative[0]));
-                for i in 1..c.outputs.len() {
-                    let missing = p.missing.iter().any(|m| m == c.outputs[i]);
+                for i in 1..outputs.len() {
+                    let missing = p.missing.iter().any(|m| m == outputs[i]);
                     let _ = write!(
                         s,
                         " {}{} |",
@@ -117,7 +126,7 @@ fn sweep_table(r: &CaseResult) -> String {
                         if missing { " (none: taken as 0)" } else { "" }
                     );
                 }
-                if r.check.is_some() {
+                if check {
                     let _ = write!(s, " {} |", p.check.map_or("–".into(), sci));
                 }
                 let _ = writeln!(
@@ -130,7 +139,7 @@ fn sweep_table(r: &CaseResult) -> String {
                 );
             }
             Status::Failed(m) | Status::Skipped(m) => {
-                let span = c.outputs.len() + usize::from(r.check.is_some()) + 4;
+                let span = outputs.len() + usize::from(check) + 4;
                 let _ = writeln!(s, " {m}{} |", " |".repeat(span - 1));
             }
         }
@@ -140,6 +149,18 @@ fn sweep_table(r: &CaseResult) -> String {
 
 /// Per formulation: its most accurate run, and the cheapest run that reaches each of `GOALS`.
 fn summary(r: &CaseResult) -> String {
+    let names: Vec<String> = r
+        .case
+        .formulations
+        .iter()
+        .map(|f| f.name.to_string())
+        .collect();
+    summary_of(&names, &r.points)
+}
+
+/// Per formulation of `names`: its most accurate point, and the cheapest that reaches each
+/// of `GOALS`.
+pub(super) fn summary_of(names: &[String], points: &[Point]) -> String {
     let mut s = format!(
         "| formulation | smallest relative error (CPU s, integrator) | {} |\n|---|---|{}\n",
         GOALS
@@ -149,11 +170,10 @@ fn summary(r: &CaseResult) -> String {
             .join(" | "),
         "---|".repeat(GOALS.len())
     );
-    for f in &r.case.formulations {
-        let pts: Vec<&Point> = r
-            .points
+    for name in names {
+        let pts: Vec<&Point> = points
             .iter()
-            .filter(|p| p.formulation == f.name && p.ok() && !p.relative[0].is_nan())
+            .filter(|p| &p.formulation == name && p.ok() && !p.relative[0].is_nan())
             .collect();
         let best = pts
             .iter()
@@ -161,7 +181,7 @@ fn summary(r: &CaseResult) -> String {
         let _ = write!(
             s,
             "| {} | {} |",
-            f.name,
+            name,
             best.map_or("every run failed".into(), |p| format!(
                 "{:.2e} ({} s, {})",
                 p.relative[0],
@@ -247,7 +267,11 @@ fn effects_table(rows: &[EffectRow], output: &str) -> String {
 }
 
 /// The whole report; `header` goes first (run time, machine, repeats).
-pub fn markdown(results: &[CaseResult], header: &str) -> String {
+pub fn markdown(
+    results: &[CaseResult],
+    spatial: Option<&spatial::Results>,
+    header: &str,
+) -> String {
     let mut s = String::from("# Work-precision report (`make bench`)\n\n");
     s += header;
     s += "\n";
@@ -289,6 +313,9 @@ pub fn markdown(results: &[CaseResult], header: &str) -> String {
             );
         }
     }
+    if let Some(r) = spatial {
+        s += &spatial::markdown(r);
+    }
     s
 }
 
@@ -296,14 +323,15 @@ pub fn markdown(results: &[CaseResult], header: &str) -> String {
 pub fn write(
     out_dir: &Path,
     results: &[CaseResult],
+    spatial: Option<&spatial::Results>,
     header: &str,
 ) -> Result<Vec<PathBuf>, HarnessError> {
     std::fs::create_dir_all(out_dir)
         .map_err(|e| HarnessError::io(out_dir, "creating the output directory", e))?;
     let mut written = Vec::new();
     for (name, text) in [
-        ("points.csv", csv(results)),
-        ("REPORT.md", markdown(results, header)),
+        ("points.csv", csv(results, spatial)),
+        ("REPORT.md", markdown(results, spatial, header)),
     ] {
         let path = out_dir.join(name);
         std::fs::write(&path, text).map_err(|e| HarnessError::io(&path, "writing", e))?;
