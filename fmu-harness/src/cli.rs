@@ -148,6 +148,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 None
             } else {
                 Some(work_precision::spatial::study(
+                    &scenes,
                     &spatial,
                     &options,
                     &mut progress,

@@ -1,10 +1,13 @@
 //! The 3D section of the study (issue 4): cases C5 and C6 (CASES.md, 3D paper §5) built in
-//! code with [`System3`] (the scene format has no 3D yet) and integrated by the same
+//! code with [`System3`] (the models of scenes/rollup_3d*.toml and pendulum_3d*.toml, with
+//! their parameters swept here) and integrated by the same
 //! generalized-α, swept over substructures, elements and integrator settings against the exact
 //! roll-up (C5) and an untimed fine run (C6); then the 3D paper's fast variants (§6), the
 //! frozen-inertia beam ([`InertiaModel::Frozen`]) and the beam from a matrix file
 //! ([`matrix_file`]), timed against the full model on C6 and on a spin-up, where the
-//! quadratic-velocity terms the variants drop are large enough to see.
+//! quadratic-velocity terms the variants drop are large enough to see; and what the planar
+//! reduction saves: a 3D scene with planar motion (scenes/rollup_3d_z.toml) with the planar
+//! element that `formulation = "auto"` picks, against the 3D element.
 
 use super::report;
 use super::{
@@ -27,8 +30,103 @@ use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-/// Names the `--cases` filter knows for this section (`3D` selects all three).
-pub const NAMES: [&str; 3] = ["C5", "C6", "F3"];
+/// Names the `--cases` filter knows for this section (`3D` selects all four): C5, C6, the
+/// fast variants (F3) and the planar reduction (P3).
+pub const NAMES: [&str; 4] = ["C5", "C6", "F3", "P3"];
+
+/// The scene of the planar-reduction measurement.
+const P3_SCENE: &str = "rollup_3d_z.toml";
+
+/// P3: the scene through the engine with the element `auto` picks, and forced to the 3D one:
+/// the table's text (timings median (min–max) of `repeats` runs, interleaved).
+fn planar_reduction(scenes_dir: &std::path::Path, repeats: usize) -> Result<String, HarnessError> {
+    let base = Scene::load(&scenes_dir.join(P3_SCENE))?;
+    let mut spatial = base.clone();
+    spatial.formulation = fmu_beam::scene::Formulation::Spatial;
+    let run_of = |scene: Scene| {
+        move || -> Result<Series, EngineError> {
+            measured(|| {
+                let mut e = fmu_beam::Engine::new(scene.clone());
+                let vr = |n: &str| e.variables().by_name(n).map(|v| v.vr);
+                let outs: Vec<u32> = [
+                    "beam.tip.x",
+                    "beam.tip.y",
+                    "solver.steps",
+                    "solver.newton_iterations",
+                    "solver.jacobians",
+                ]
+                .iter()
+                .filter_map(|n| vr(n))
+                .collect();
+                e.exit_initialization()?;
+                let h = scene.experiment.step_size;
+                let steps = (scene.experiment.stop_time / h).round() as usize;
+                let mut values = vec![Vec::new(), Vec::new()];
+                for k in 0..steps {
+                    e.do_step(k as f64 * h, h)?;
+                    values[0].push(e.get_real(outs[0])?);
+                    values[1].push(e.get_real(outs[1])?);
+                }
+                let mut count = |i: usize| e.get_integer(outs[i]).map(|x| x as u64);
+                let stats = Stats {
+                    steps: count(2)?,
+                    newton_iterations: count(3)?,
+                    jacobians: count(4)?,
+                    ..Stats::default()
+                };
+                Ok((values, stats))
+            })
+        }
+    };
+    let (planar_run, spatial_run) = (run_of(base.clone()), run_of(spatial));
+    let timed = timed_together(&[&planar_run, &spatial_run], repeats);
+    let mut rows = Vec::new();
+    for t in timed {
+        let (series, cpu, _) = t.map_err(|source| HarnessError::Engine {
+            origin: format!("{P3_SCENE} (planar reduction)"),
+            source,
+        })?;
+        rows.push((series, cpu));
+    }
+    let diff = (0..2)
+        .map(|k| {
+            rows[0].0.values[k]
+                .iter()
+                .zip(&rows[1].0.values[k])
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    let mut s = format!(
+        "### The planar reduction: a 3D scene with planar motion\n\n\
+         `{P3_SCENE}` (C5 about z, {} s, the scene's own solver settings: fixed step {:.0e} s, \
+         Newton tolerance {:.0e}) through the engine: with `formulation = \"auto\"` its motion \
+         stays in the x–y plane and it runs with the planar element; with `formulation = \
+         \"spatial\"` with the 3D element. CPU s of the whole run, median (min–max) of {} \
+         interleaved runs. Largest difference of the tip's x and y over the run: {diff:.1e} m \
+         (L = 1 m; Newton's stopping error at this tolerance, see `tests/test_3d.py`).\n\n\
+         | element | CPU s median (min–max) | time / planar | steps | Newton | LU |\n\
+         |---|---|---|---|---|---|\n",
+        base.experiment.stop_time,
+        base.solver.max_step,
+        base.solver.tolerance,
+        repeats.max(1)
+    );
+    for (name, (series, cpu)) in ["planar (auto)", "3D (spatial)"].iter().zip(&rows) {
+        let _ = writeln!(
+            s,
+            "| {name} | {:.3} ({:.3}–{:.3}) | {:.1} | {} | {} | {} |",
+            cpu[0],
+            cpu[1],
+            cpu[2],
+            cpu[0] / rows[0].1[0],
+            series.stats[0],
+            series.stats[1],
+            series.stats[2]
+        );
+    }
+    Ok(s)
+}
 
 // C5/C6's beam (CASES.md): steel, 0.02 × 0.06285 m rectangle.
 const RHO: f64 = 7800.0;
@@ -71,6 +169,8 @@ const SPIN_COMM: f64 = 1e-2;
 pub struct Results {
     pub sweeps: Vec<Sweep>,
     pub variants: Vec<VariantTable>,
+    /// The planar-reduction table (P3), as text.
+    pub reduction: Option<String>,
     /// Wall seconds the section took.
     pub seconds: f64,
 }
@@ -621,6 +721,7 @@ fn c6_lag(ends: &[(usize, Setting, f64)], reference: &[f64], moved: f64) -> Stri
 /// Runs the 3D section for the names in `chosen` (of [`NAMES`]); `progress` receives a line
 /// per point.
 pub fn study(
+    scenes_dir: &std::path::Path,
     chosen: &[&str],
     options: &Options,
     progress: &mut dyn FnMut(&str),
@@ -909,9 +1010,16 @@ pub fn study(
             });
         }
     }
+    let reduction = if chosen.contains(&"P3") {
+        tick("P3: planar reduction of rollup_3d_z");
+        Some(planar_reduction(scenes_dir, options.repeats)?)
+    } else {
+        None
+    };
     Ok(Results {
         sweeps,
         variants,
+        reduction,
         seconds: started.elapsed().as_secs_f64(),
     })
 }
@@ -987,6 +1095,10 @@ pub fn markdown(r: &Results) -> String {
         for t in &r.variants {
             let _ = writeln!(s, "#### {}\n\n{}\n\n{}", t.title, t.setup, variant_table(t));
         }
+    }
+    if let Some(r) = &r.reduction {
+        s += r;
+        s += "\n";
     }
     s
 }
