@@ -735,27 +735,28 @@ fn spatial_section_params(t: &mut Builder, b: &crate::scene::BeamSpec, i: usize,
     if rigid {
         return;
     }
-    param(
-        "Iy",
-        T::BeamIy(i),
-        "m4",
-        s.iy.unwrap_or(0.0),
-        "Second moment of area Iy (bending in the local x-z plane)",
-    );
-    param(
-        "Iz",
-        T::BeamIz(i),
-        "m4",
-        s.iz.unwrap_or(0.0),
-        "Second moment of area Iz (bending in the local x-y plane)",
-    );
-    param(
-        "It",
-        T::BeamTorsion(i),
-        "m4",
-        s.torsion_constant.unwrap_or(0.0),
-        "Saint-Venant torsion constant",
-    );
+    for (name, target, value, desc) in [
+        (
+            "Iy",
+            T::BeamIy(i),
+            s.iy,
+            "Second moment of area Iy (bending in the local x-z plane)",
+        ),
+        (
+            "Iz",
+            T::BeamIz(i),
+            s.iz,
+            "Second moment of area Iz (bending in the local x-y plane)",
+        ),
+        (
+            "It",
+            T::BeamTorsion(i),
+            s.torsion_constant,
+            "Saint-Venant torsion constant",
+        ),
+    ] {
+        param(name, target, "m4", value.unwrap_or(0.0), desc);
+    }
 }
 
 struct Builder {

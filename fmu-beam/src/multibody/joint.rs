@@ -97,6 +97,24 @@ pub struct Drive {
     pub law: TimeLaw,
 }
 
+impl Drive {
+    /// The drive of a scene joint, if it has one; an `input` law reads the joint's input slot.
+    pub fn of_joint(
+        j: &crate::scene::JointSpec,
+        slots: &[crate::multibody::system::InputSlot],
+    ) -> Option<Drive> {
+        j.drive.as_ref().map(|d| Drive {
+            kind: d.kind,
+            law: TimeLaw::from_spec(
+                &d.law,
+                slots
+                    .iter()
+                    .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
+            ),
+        })
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Joint {
     pub name: String,

@@ -271,15 +271,7 @@ impl System {
         for j in &scene.joints {
             let f0 = sys.frame_by_name(&j.frames[0]);
             let f1 = sys.frame_by_name(&j.frames[1]);
-            let drive = j.drive.as_ref().map(|d| Drive {
-                kind: d.kind,
-                law: TimeLaw::from_spec(
-                    &d.law,
-                    slots
-                        .iter()
-                        .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
-                ),
-            });
+            let drive = Drive::of_joint(j, &slots);
             let offset = sys.relative_angle(f0, f1, &q0);
             let count = Joint::rows_count(j.kind, drive.as_ref());
             sys.joints.push(Joint {

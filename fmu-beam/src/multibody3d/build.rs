@@ -255,15 +255,7 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
         };
         let f0 = frame(&mut sys, &j.frames[0], w);
         let f1 = frame(&mut sys, &j.frames[1], w);
-        let drive = j.drive.as_ref().map(|d| Drive {
-            kind: d.kind,
-            law: TimeLaw::from_spec(
-                &d.law,
-                slots
-                    .iter()
-                    .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
-            ),
-        });
+        let drive = Drive::of_joint(j, &slots);
         index
             .joints
             .push(sys.add_joint(&j.name, kind, f0, f1, drive));
