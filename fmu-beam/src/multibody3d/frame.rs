@@ -2,7 +2,8 @@
 //! of a beam, or a named frame of a rigid body), with a constant rotation offset.
 
 use super::body::{frame_of, FRAME};
-use crate::beam::spatial_beam::SpatialPointMap;
+use super::quaternion::{left_jacobian, rotation_derivatives};
+use crate::beam::spatial_beam::{skew, SpatialPointMap};
 use nalgebra::{DMatrix, DVectorView, Matrix3, Rotation3, Vector3};
 
 #[derive(Debug, Clone)]
@@ -72,6 +73,48 @@ impl Frame3 {
             }
             (Frame3::OnBody { .. }, None) => panic!("a body frame needs its body's coordinates"),
         }
+    }
+
+    /// The pose and, in `out`, its derivatives (∂x, ∂A_f) over the [`Frame3::active`]
+    /// coordinates in that order: ∂x/∂R = I, ∂x/∂p_k = ∂A/∂p_k s, ∂x/∂q_f = A S_p;
+    /// ∂A_f/∂p_k = ∂A/∂p_k E C, ∂A_f/∂q_f = A (J_l(φ) S_φ)~ E C with E = exp(φ̃).
+    pub fn pose_derivatives(
+        &self,
+        z: Option<DVectorView<f64>>,
+        out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>,
+    ) -> (Vector3<f64>, Matrix3<f64>) {
+        out.clear();
+        let (
+            Frame3::OnBody {
+                map,
+                rotation,
+                active,
+                ..
+            },
+            Some(z),
+        ) = (self, z)
+        else {
+            return self.pose(z);
+        };
+        let (r, p, a) = frame_of(&z);
+        let f = z.rows(FRAME, map.sp.ncols());
+        let s = map.s0 + mul(&map.sp, &f);
+        let phi = mul(&map.sphi, &f);
+        let ec = Rotation3::from_scaled_axis(phi).into_inner() * rotation;
+        for i in 0..3 {
+            out.push((Vector3::ith(i, 1.0), Matrix3::zeros()));
+        }
+        for da in rotation_derivatives(&p) {
+            out.push((da * s, da * ec));
+        }
+        let jl = left_jacobian(&phi);
+        for &k in &active[FRAME..] {
+            let c = k - FRAME;
+            let sp = Vector3::new(map.sp[(0, c)], map.sp[(1, c)], map.sp[(2, c)]);
+            let sphi = Vector3::new(map.sphi[(0, c)], map.sphi[(1, c)], map.sphi[(2, c)]);
+            out.push((a * sp, a * skew(&(jl * sphi)) * ec));
+        }
+        (r + a * s, a * ec)
     }
 }
 

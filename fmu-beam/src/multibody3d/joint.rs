@@ -120,6 +120,100 @@ impl Joint3 {
         }
     }
 
+    /// Second time derivative of the rows along a motion of the two frames, at a fixed drive
+    /// law, from the poses, their rates r = (ẋ, Ȧ) and accelerations a = (ẍ, Ä). Every row is
+    /// a product of two pose factors (or the angle atan2(s, c) of two), so the rule is
+    /// (u·w)¨ = ü·w + 2 u̇·ẇ + u·ẅ. With zero rates it is the rows' derivative along the pose
+    /// variations a0, a1: a column of the constraint Jacobian.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rows_acceleration(
+        &self,
+        f0: &Pose,
+        f1: &Pose,
+        r0: &Pose,
+        r1: &Pose,
+        a0: &Pose,
+        a1: &Pose,
+        out: &mut [f64],
+    ) {
+        let dd = a1.0 - a0.0;
+        let mut k = 0;
+        let mut push = |v: f64| {
+            out[k] = v;
+            k += 1;
+        };
+        // ½ vee(Ẅ − Ẅᵀ) of W = A0ᵀ A1
+        let rotation_rows = |push: &mut dyn FnMut(f64)| {
+            let w = a0.1.tr_mul(&f1.1) + r0.1.tr_mul(&r1.1) * 2.0 + f0.1.tr_mul(&a1.1);
+            push(0.5 * (w[(2, 1)] - w[(1, 2)]));
+            push(0.5 * (w[(0, 2)] - w[(2, 0)]));
+            push(0.5 * (w[(1, 0)] - w[(0, 1)]));
+        };
+        match self.kind {
+            JointKind3::Weld => {
+                dd.iter().for_each(|&v| push(v));
+                rotation_rows(&mut push);
+            }
+            JointKind3::Revolute => {
+                dd.iter().for_each(|&v| push(v));
+                for c in 0..2 {
+                    push(col_product(f1, r1, a1, 2, f0, r0, a0, c));
+                }
+            }
+            JointKind3::Prismatic => {
+                rotation_rows(&mut push);
+                for c in 1..3 {
+                    push(gap_product(f0, f1, r0, r1, a0, a1, c));
+                }
+            }
+            JointKind3::Spherical => dd.iter().for_each(|&v| push(v)),
+        }
+        if self
+            .drive
+            .as_ref()
+            .is_some_and(|d| d.kind == DriveKind::Motion)
+        {
+            push(self.coordinate_acceleration(f0, f1, r0, r1, a0, a1));
+        }
+    }
+
+    /// Second time derivative of [`Joint3::coordinate`] (see [`Joint3::rows_acceleration`]);
+    /// with zero rates, its derivative along a0, a1. For the angle θ = atan2(s, c):
+    /// θ̈ = (c s̈ − s c̈)/ρ − 2 (c ṡ − s ċ)(s ṡ + c ċ)/ρ², ρ = s² + c².
+    #[allow(clippy::too_many_arguments)]
+    pub fn coordinate_acceleration(
+        &self,
+        f0: &Pose,
+        f1: &Pose,
+        r0: &Pose,
+        r1: &Pose,
+        a0: &Pose,
+        a1: &Pose,
+    ) -> f64 {
+        match self.kind {
+            JointKind3::Revolute => {
+                let e = |m: &Matrix3<f64>| m.column(0).into_owned();
+                let (x, xd, xdd) = (e(&f1.1), e(&r1.1), e(&a1.1));
+                let c3 = |m: &Matrix3<f64>, i| m.column(i).into_owned();
+                let prod = |i: usize| {
+                    let (u, ud, udd) = (c3(&f0.1, i), c3(&r0.1, i), c3(&a0.1, i));
+                    (
+                        x.dot(&u),
+                        xd.dot(&u) + x.dot(&ud),
+                        xdd.dot(&u) + 2.0 * xd.dot(&ud) + x.dot(&udd),
+                    )
+                };
+                let (s, sd, sdd) = prod(1);
+                let (c, cd, cdd) = prod(0);
+                let rho = s * s + c * c;
+                (c * sdd - s * cdd) / rho
+                    - 2.0 * (c * sd - s * cd) * (s * sd + c * cd) / (rho * rho)
+            }
+            JointKind3::Prismatic => gap_product(f0, f1, r0, r1, a0, a1, 0),
+            _ => 0.0,
+        }
+    }
+
     /// Second time derivative of the drive law (the time part of the motion row's bias).
     pub fn drive_acceleration(&self, t: f64, inputs: &[InputValue]) -> Option<f64> {
         self.drive
@@ -135,4 +229,36 @@ impl Joint3 {
             .filter(|d| d.kind == DriveKind::Effort)
             .map(|d| d.law.eval(t, inputs).0)
     }
+}
+
+/// (u·w)¨ for u column `cu` of frame u's rotation, w column `cw` of frame w's.
+#[allow(clippy::too_many_arguments)]
+fn col_product(
+    fu: &Pose,
+    ru: &Pose,
+    au: &Pose,
+    cu: usize,
+    fw: &Pose,
+    rw: &Pose,
+    aw: &Pose,
+    cw: usize,
+) -> f64 {
+    let (u, ud, udd) = (fu.1.column(cu), ru.1.column(cu), au.1.column(cu));
+    let (w, wd, wdd) = (fw.1.column(cw), rw.1.column(cw), aw.1.column(cw));
+    udd.dot(&w) + 2.0 * ud.dot(&wd) + u.dot(&wdd)
+}
+
+/// (d·c)¨ for d = x1 − x0 and c column `col` of frame 0's rotation.
+fn gap_product(
+    f0: &Pose,
+    f1: &Pose,
+    r0: &Pose,
+    r1: &Pose,
+    a0: &Pose,
+    a1: &Pose,
+    col: usize,
+) -> f64 {
+    let (d, dd, ddd) = (f1.0 - f0.0, r1.0 - r0.0, a1.0 - a0.0);
+    let (c, cd, cdd) = (f0.1.column(col), r0.1.column(col), a0.1.column(col));
+    ddd.dot(&c) + 2.0 * dd.dot(&cd) + d.dot(&cdd)
 }

@@ -43,3 +43,40 @@ pub fn rotation_error(a0: &Matrix3<f64>, a1: &Matrix3<f64>) -> Vector3<f64> {
         r[(1, 0)] - r[(0, 1)],
     ) * 0.5
 }
+
+/// ∂A/∂p_k (k = 0..4) of [`rotation`] as written (not restricted to |p| = 1):
+/// ∂A/∂e0 = 2 e0 I + 2 ẽ, ∂A/∂e_i = −2 e_i I + 2 (u_i eᵀ + e u_iᵀ) + 2 e0 ũ_i.
+pub fn rotation_derivatives(p: &Vector4<f64>) -> [Matrix3<f64>; 4] {
+    let e0 = p[0];
+    let e = Vector3::new(p[1], p[2], p[3]);
+    let skew = crate::beam::spatial_beam::skew;
+    let d = |i: usize| {
+        let u = Vector3::ith(i, 1.0);
+        Matrix3::identity() * (-2.0 * e[i])
+            + (u * e.transpose() + e * u.transpose()) * 2.0
+            + skew(&u) * (2.0 * e0)
+    };
+    [
+        Matrix3::identity() * (2.0 * e0) + skew(&e) * 2.0,
+        d(0),
+        d(1),
+        d(2),
+    ]
+}
+
+/// Left Jacobian of the rotation vector: d exp(φ̃) = (J_l(φ) dφ)~ exp(φ̃), with
+/// J_l = I + (1 − cos θ)/θ² φ̃ + (θ − sin θ)/θ³ φ̃², θ = |φ| (series below θ = 1e-2).
+pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let x = phi.norm_squared();
+    let (b, c) = if x < 1e-4 {
+        (
+            0.5 - x / 24.0 + x * x / 720.0,
+            1.0 / 6.0 - x / 120.0 + x * x / 5040.0,
+        )
+    } else {
+        let th = x.sqrt();
+        ((1.0 - th.cos()) / x, (th - th.sin()) / (x * th))
+    };
+    let s = crate::beam::spatial_beam::skew(phi);
+    Matrix3::identity() + s * b + s * s * c
+}

@@ -314,8 +314,45 @@ impl System3 {
         }
     }
 
-    /// ∂(joint coordinate)/∂q over the joint's columns (central differences).
+    /// Pose of frame `f` and its derivatives over [`System3::frame_columns`] (same order).
+    fn frame_pose_derivatives(
+        &self,
+        f: usize,
+        q: &DVector<f64>,
+        out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>,
+    ) -> Pose {
+        let fr = &self.frames[f];
+        fr.pose_derivatives(fr.body().map(|b| self.body_coords(b, q)), out)
+    }
+
+    /// ∂(joint coordinate)/∂q over the joint's columns (closed form; a column shared by both
+    /// frames appears twice, the entries add).
     fn coordinate_gradient(&self, j: usize, q: &DVector<f64>) -> Vec<(usize, f64)> {
+        let jt = &self.joints[j];
+        let (mut d0, mut d1) = (Vec::new(), Vec::new());
+        let p0 = self.frame_pose_derivatives(jt.frames[0], q, &mut d0);
+        let p1 = self.frame_pose_derivatives(jt.frames[1], q, &mut d1);
+        let zero = (Vector3::zeros(), Matrix3::zeros());
+        let c0 = self.frame_columns(jt.frames[0]).into_iter().zip(&d0);
+        let c1 = self.frame_columns(jt.frames[1]).into_iter().zip(&d1);
+        c0.map(|(k, d)| {
+            (
+                k,
+                jt.coordinate_acceleration(&p0, &p1, &zero, &zero, d, &zero),
+            )
+        })
+        .chain(c1.map(|(k, d)| {
+            (
+                k,
+                jt.coordinate_acceleration(&p0, &p1, &zero, &zero, &zero, d),
+            )
+        }))
+        .collect()
+    }
+
+    /// ∂(joint coordinate)/∂q over the joint's columns by central differences: the reference
+    /// of the closed form [`System3::coordinate_gradient`] in the tests.
+    pub fn coordinate_gradient_differences(&self, j: usize, q: &DVector<f64>) -> Vec<(usize, f64)> {
         let jt = &self.joints[j];
         let mut qq = q.clone();
         self.joint_columns(jt)
@@ -337,7 +374,40 @@ impl System3 {
             .collect()
     }
 
-    /// Generalized force of a world force and torque on frame `f`: Σ F·∂x/∂q_k + τ·∂θ/∂q_k.
+    /// The constraint Jacobian by central differences per joint column: the reference of the
+    /// closed form ([`Equations::constraint_jacobian`]) in the tests.
+    pub fn constraint_jacobian_differences(&self, q: &DVector<f64>, t: f64, gm: &mut DMatrix<f64>) {
+        gm.fill(0.0);
+        for (i, &o) in self.offsets.iter().enumerate() {
+            for k in 0..4 {
+                gm[(i, o + 3 + k)] = 2.0 * q[o + 3 + k];
+            }
+        }
+        let nb = self.bodies.len();
+        let mut qq = q.clone();
+        let (mut gp, mut gn) = ([0.0; 6], [0.0; 6]);
+        for j in &self.joints {
+            let (r, l) = (nb + j.row, j.len());
+            for k in self.joint_columns(j) {
+                let x = q[k];
+                qq[k] = x + EPS_CENTRAL;
+                self.joint_values(j, &qq, t, &mut gp[..l]);
+                qq[k] = x - EPS_CENTRAL;
+                self.joint_values(j, &qq, t, &mut gn[..l]);
+                qq[k] = x;
+                for s in 0..l {
+                    let mut d = gp[s] - gn[s];
+                    if s == 5 && j.kind == JointKind3::Revolute {
+                        d = wrap(d);
+                    }
+                    gm[(r + s, k)] = d / (2.0 * EPS_CENTRAL);
+                }
+            }
+        }
+    }
+
+    /// Generalized force of a world force and torque on frame `f`: Σ F·∂x/∂q_k + τ·∂θ/∂q_k,
+    /// with ∂θ̃ = ∂A Aᵀ (its skew part).
     fn frame_force(
         &self,
         f: usize,
@@ -345,25 +415,19 @@ impl System3 {
         force: &Vector3<f64>,
         torque: &Vector3<f64>,
     ) -> Vec<(usize, f64)> {
-        let (_, a) = self.frame_pose(f, q);
-        let mut qq = q.clone();
+        let mut d = Vec::new();
+        let (_, a) = self.frame_pose_derivatives(f, q, &mut d);
         self.frame_columns(f)
             .into_iter()
-            .map(|k| {
-                let x = q[k];
-                qq[k] = x + EPS_CENTRAL;
-                let (xp, ap) = self.frame_pose(f, &qq);
-                qq[k] = x - EPS_CENTRAL;
-                let (xm, am) = self.frame_pose(f, &qq);
-                qq[k] = x;
-                let dx = (xp - xm) / (2.0 * EPS_CENTRAL);
-                let w = (ap - am) * a.transpose() / (2.0 * EPS_CENTRAL);
+            .zip(&d)
+            .map(|(k, (dx, da))| {
+                let w = da * a.transpose();
                 let dth = Vector3::new(
                     w[(2, 1)] - w[(1, 2)],
                     w[(0, 2)] - w[(2, 0)],
                     w[(1, 0)] - w[(0, 1)],
                 ) * 0.5;
-                (k, force.dot(&dx) + torque.dot(&dth))
+                (k, force.dot(dx) + torque.dot(&dth))
             })
             .collect()
     }
@@ -556,7 +620,9 @@ impl Equations for System3 {
         }
     }
 
-    fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, gm: &mut DMatrix<f64>) {
+    /// Norm rows 2pᵀ; joint rows in closed form, each column the rows' derivative along the
+    /// pose derivatives of one coordinate ([`Joint3::rows_acceleration`] at zero rates).
+    fn constraint_jacobian(&self, q: &DVector<f64>, _t: f64, gm: &mut DMatrix<f64>) {
         gm.fill(0.0);
         for (i, &o) in self.offsets.iter().enumerate() {
             for k in 0..4 {
@@ -564,23 +630,23 @@ impl Equations for System3 {
             }
         }
         let nb = self.bodies.len();
-        let mut qq = q.clone();
-        let (mut gp, mut gn) = ([0.0; 6], [0.0; 6]);
+        let zero = (Vector3::zeros(), Matrix3::zeros());
+        let (mut d0, mut d1) = (Vec::new(), Vec::new());
+        let mut col = [0.0; 6];
         for j in &self.joints {
             let (r, l) = (nb + j.row, j.len());
-            for k in self.joint_columns(j) {
-                let x = q[k];
-                qq[k] = x + EPS_CENTRAL;
-                self.joint_values(j, &qq, t, &mut gp[..l]);
-                qq[k] = x - EPS_CENTRAL;
-                self.joint_values(j, &qq, t, &mut gn[..l]);
-                qq[k] = x;
-                for s in 0..l {
-                    let mut d = gp[s] - gn[s];
-                    if s == 5 && j.kind == JointKind3::Revolute {
-                        d = wrap(d);
+            let p0 = self.frame_pose_derivatives(j.frames[0], q, &mut d0);
+            let p1 = self.frame_pose_derivatives(j.frames[1], q, &mut d1);
+            for (side, d) in [&d0, &d1].into_iter().enumerate() {
+                let f = &self.frames[j.frames[side]];
+                let Some(b) = f.body() else { continue };
+                for (&k, dk) in f.active().iter().zip(d) {
+                    let (a0, a1) = if side == 0 { (dk, &zero) } else { (&zero, dk) };
+                    j.rows_acceleration(&p0, &p1, &zero, &zero, a0, a1, &mut col[..l]);
+                    let c = self.offsets[b] + k;
+                    for s in 0..l {
+                        gm[(r + s, c)] += col[s];
                     }
-                    gm[(r + s, k)] = d / (2.0 * EPS_CENTRAL);
                 }
             }
         }

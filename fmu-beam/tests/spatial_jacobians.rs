@@ -1,0 +1,226 @@
+//! The closed-form derivatives of the spatial system against finite differences, on random
+//! states (quaternions off the unit sphere, deformed beams, rotated frames): the constraint
+//! Jacobian of every joint kind with and without a motion drive, the joint-coordinate gradient
+//! (joint rates, effort drives) and the generalized force of a load.
+
+mod common;
+
+use fmu_beam::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use fmu_beam::beam::spatial_section::SpatialSection;
+use fmu_beam::multibody::joint::Drive;
+use fmu_beam::multibody::law::{Law, TimeLaw};
+use fmu_beam::multibody::Equations;
+use fmu_beam::multibody3d::{JointKind3, Load3, RigidBody3, System3};
+use fmu_beam::scene::{DriveKind, FrameKind};
+use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
+
+/// A small deterministic generator (xorshift) of numbers in [−1, 1].
+struct Random(u64);
+
+impl Random {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+    fn vector(&mut self, scale: f64) -> Vector3<f64> {
+        Vector3::new(self.next(), self.next(), self.next()) * scale
+    }
+    fn rotation(&mut self) -> Matrix3<f64> {
+        Rotation3::from_scaled_axis(self.vector(2.0)).into_inner()
+    }
+}
+
+fn drive(kind: DriveKind) -> Option<Drive> {
+    Some(Drive {
+        kind,
+        law: TimeLaw {
+            law: Law::Constant(0.3),
+            until: None,
+        },
+    })
+}
+
+/// Two beams (one of two substructures, welded), a rigid body, and one joint of each kind with
+/// and without drives between frames on all of them, rotated at random.
+fn system(rng: &mut Random) -> System3 {
+    let section = SpatialSection::given(1e-4, 2e-9, 1e-9, 1.5e-9);
+    let props = |frame| SpatialBeamProps {
+        length: 0.8,
+        elements: 2,
+        frame,
+        rho: 7800.0,
+        e: 2e11,
+        g: 8e10,
+        section: section.clone(),
+        rayleigh_alpha: 0.0,
+        rayleigh_beta: 0.0,
+        inertia: InertiaModel::Full,
+    };
+    let mut sys = System3::new(Some(Vector3::new(0.0, 0.0, -9.81)));
+    let b0 = sys.add_beam(
+        "b0",
+        &props(FrameKind::Tangent),
+        2,
+        rng.vector(0.5),
+        rng.rotation(),
+    );
+    let b1 = sys.add_beam(
+        "b1",
+        &props(FrameKind::Pinned),
+        1,
+        rng.vector(0.5),
+        rng.rotation(),
+    );
+    let rigid = sys.add_rigid(
+        RigidBody3 {
+            name: "r".into(),
+            mass: 2.0,
+            com: rng.vector(0.1),
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3)),
+            frames: vec![("f".into(), rng.vector(0.3), rng.rotation())],
+        },
+        rng.vector(0.5),
+        rng.rotation(),
+    );
+    let kinds = [
+        (JointKind3::Weld, None),
+        (JointKind3::Revolute, None),
+        (JointKind3::Revolute, drive(DriveKind::Motion)),
+        (JointKind3::Revolute, drive(DriveKind::Effort)),
+        (JointKind3::Prismatic, None),
+        (JointKind3::Prismatic, drive(DriveKind::Motion)),
+        (JointKind3::Prismatic, drive(DriveKind::Effort)),
+        (JointKind3::Spherical, None),
+    ];
+    for (i, (kind, dr)) in kinds.into_iter().enumerate() {
+        let f0 = match i % 3 {
+            0 => sys.beam_frame(b0, true, rng.rotation()),
+            1 => sys.world_frame(rng.vector(0.5), rng.rotation()),
+            _ => sys.beam_frame(b1, false, rng.rotation()),
+        };
+        let f1 = match i % 2 {
+            0 => sys.rigid_frame(rigid, "f"),
+            _ => sys.beam_frame(b1, true, rng.rotation()),
+        };
+        sys.add_joint(&format!("j{i}"), kind, f0, f1, dr);
+    }
+    let tip = sys.beam_frame(b0, true, rng.rotation());
+    sys.add_load(Load3 {
+        name: "load".into(),
+        frame: tip,
+        force: rng.vector(10.0),
+        torque: rng.vector(5.0),
+        law: None,
+    });
+    sys
+}
+
+/// A random state: frames moved and turned, quaternions off the unit sphere, beams deformed
+/// (section rotations up to about 0.3 rad).
+fn state(sys: &System3, rng: &mut Random) -> DVector<f64> {
+    let scene = common::scene("flexible_pendulum.toml"); // not read by System3
+    let mut q = sys.initial_coordinates(&scene).expect("placement");
+    for i in 0..sys.bodies.len() {
+        let o = sys.offsets[i];
+        for k in 0..sys.bodies[i].ncoords() {
+            q[o + k] += rng.next() * if k < 3 { 0.1 } else { 0.15 };
+        }
+    }
+    q
+}
+
+fn relative(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax() / b.amax()
+}
+
+#[test]
+fn constraint_jacobian_matches_central_differences_for_every_joint_kind() {
+    let mut rng = Random(0x9e37_79b9_7f4a_7c15);
+    let sys = system(&mut rng);
+    let (n, m) = (sys.n(), sys.m());
+    for _ in 0..5 {
+        let q = state(&sys, &mut rng);
+        let (mut g, mut gd) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
+        sys.constraint_jacobian(&q, 0.1, &mut g);
+        sys.constraint_jacobian_differences(&q, 0.1, &mut gd);
+        for (j, jt) in sys.joints.iter().enumerate() {
+            let rows = sys.joint_row(j)..sys.joint_row(j) + jt.len();
+            let (a, b) = (
+                g.rows(rows.start, rows.len()),
+                gd.rows(rows.start, rows.len()),
+            );
+            let err = (a - b).amax() / b.amax();
+            println!(
+                "{:?} {:?}: {err:.1e}",
+                jt.kind,
+                jt.drive.as_ref().map(|d| d.kind)
+            );
+            assert!(err < 1e-6, "joint {j} ({:?}): {err:.2e}", jt.kind);
+        }
+        assert!(relative(&g, &gd) < 1e-6);
+    }
+}
+
+#[test]
+fn joint_rates_match_central_differences_of_the_joint_coordinate() {
+    let mut rng = Random(0x2545_f491_4f6c_dd1d);
+    let sys = system(&mut rng);
+    for _ in 0..5 {
+        let q = state(&sys, &mut rng);
+        let v = DVector::from_fn(sys.n(), |_, _| rng.next());
+        for (j, jt) in sys.joints.iter().enumerate() {
+            if !matches!(jt.kind, JointKind3::Revolute | JointKind3::Prismatic) {
+                continue;
+            }
+            let rate = sys.joint_rate(j, &q, &v);
+            let fd: f64 = sys
+                .coordinate_gradient_differences(j, &q)
+                .into_iter()
+                .map(|(k, d)| d * v[k])
+                .sum();
+            println!("{:?}: rate {rate:.6e}, differences {fd:.6e}", jt.kind);
+            assert!((rate - fd).abs() <= 1e-6 * fd.abs().max(1.0), "joint {j}");
+        }
+    }
+}
+
+#[test]
+fn load_force_matches_central_differences_of_the_frame_pose() {
+    let mut rng = Random(0x1234_5678_9abc_def1);
+    let sys = system(&mut rng);
+    let mut unloaded = sys.clone();
+    unloaded.loads.clear();
+    // effort drives act on both; their difference is the load alone
+    let load = &sys.loads[0];
+    for _ in 0..5 {
+        let q = state(&sys, &mut rng);
+        let (v, a) = (DVector::zeros(sys.n()), DVector::zeros(sys.n()));
+        let (mut r, mut r0) = (DVector::zeros(sys.n()), DVector::zeros(sys.n()));
+        sys.body_residual(&q, &v, &a, 0.0, &mut r);
+        unloaded.body_residual(&q, &v, &a, 0.0, &mut r0);
+        let force = r0 - r;
+        let (_, rot) = sys.frame_pose(load.frame, &q);
+        let h = 1e-6;
+        let mut fd = DVector::zeros(sys.n());
+        let mut qq = q.clone();
+        for k in 0..sys.n() {
+            qq[k] = q[k] + h;
+            let (xp, ap) = sys.frame_pose(load.frame, &qq);
+            qq[k] = q[k] - h;
+            let (xm, am) = sys.frame_pose(load.frame, &qq);
+            qq[k] = q[k];
+            let w = (ap - am) * rot.transpose() / (2.0 * h);
+            let dth = Vector3::new(
+                w[(2, 1)] - w[(1, 2)],
+                w[(0, 2)] - w[(2, 0)],
+                w[(1, 0)] - w[(0, 1)],
+            ) * 0.5;
+            fd[k] = load.force.dot(&((xp - xm) / (2.0 * h))) + load.torque.dot(&dth);
+        }
+        let err = (&force - &fd).amax() / fd.amax();
+        println!("load: {err:.1e}");
+        assert!(err < 1e-6, "{err:.2e}");
+    }
+}
