@@ -567,6 +567,37 @@ fn gravity_is_the_gradient_of_the_potential() {
     }
 }
 
+/// The residual, evaluated by blocks, equals M v̇ + h − Q_g + [0; 0; K_ff q_f + D_ff q̇_f]
+/// from the full matrices, in both inertia models.
+#[test]
+fn residual_equals_mass_times_acceleration_plus_forces() {
+    let mut rng = Lcg(11);
+    for model in [InertiaModel::Full, InertiaModel::Frozen] {
+        let p = SpatialBeamProps {
+            rayleigh_alpha: 3.0,
+            rayleigh_beta: 1e-4,
+            inertia: model,
+            ..props(0.8, 3, FrameKind::Tangent)
+        };
+        let b = SpatialBeam::new("b", &p);
+        let nf = b.nflex();
+        for _ in 0..3 {
+            let s = random_state(&b, &mut rng);
+            let vd = rng.vec(b.ndof(), 5.0);
+            let g = rng.vec3(9.81);
+            let r = b.residual(&s.a, &s.f, &s.v, &vd, &g);
+            let mut parts = b.mass_matrix_owned(&s.a, &s.f) * &vd
+                + b.quadratic_velocity(&s.a, &s.f, &s.v)
+                - b.gravity_force(&s.a, &s.f, &g);
+            let mut pf = parts.rows_mut(FLEX, nf);
+            pf += b.internal_force(&s.f, s.v.rows(FLEX, nf));
+            let err = rel_v(&r, &parts);
+            println!("{model:?}: |r − parts|/|parts| = {err:.1e}");
+            assert!(err < 1e-13, "{model:?}: {err:e}");
+        }
+    }
+}
+
 #[test]
 fn zero_force_at_rest_and_steady_spin() {
     let b = beam(FrameKind::Tangent, 4);

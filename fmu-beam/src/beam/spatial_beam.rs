@@ -119,6 +119,32 @@ fn pair_index(i: usize, j: usize) -> (usize, bool) {
     (PAIRS.iter().position(|&p| p == (a, b)).unwrap(), t)
 }
 
+/// The q_f-dependent inertia of the model in force, computed once per q_f and shared by the
+/// mass matrix, the quadratic-velocity vector and the residual (and by the tangent columns
+/// that leave q_f unchanged).
+#[derive(Debug, Clone)]
+pub struct FlexInertia {
+    /// Static moment c, I_θθ and I_θf (3 × nf).
+    pub c: Vector3<f64>,
+    pub ithth: Matrix3<f64>,
+    pub ithf: DMatrix<f64>,
+    /// Full model: M^k q_f for k in [`PAIRS`], and M^kᵀ q_f for the three off the diagonal
+    /// (k = 3, 4, 5); `None` in the frozen model.
+    products: Option<([DVector<f64>; 6], [DVector<f64>; 3])>,
+}
+
+impl FlexInertia {
+    /// M^{ij} q_f (`transposed`: M^{ij}ᵀ q_f = M^{ji} q_f) of the full model.
+    fn product(&self, k: usize, transposed: bool) -> &DVector<f64> {
+        let (mf, mtf) = self.products.as_ref().expect("full model");
+        if transposed && k >= 3 {
+            &mtf[k - 3]
+        } else {
+            &mf[k]
+        }
+    }
+}
+
 /// Inertia of the undeformed beam in its frame: everything [`InertiaModel::Frozen`] needs, and
 /// all a 12 × 12 nodal mass matrix can give.
 #[derive(Debug, Clone)]
@@ -419,12 +445,26 @@ impl SpatialBeam {
         &self,
         f: &DVectorView<f64>,
     ) -> (Vector3<f64>, Matrix3<f64>, DMatrix<f64>) {
+        let fi = self.flex_inertia(*f);
+        (fi.c, fi.ithth, fi.ithf)
+    }
+
+    /// The q_f-dependent inertia of the model in force (nine products M^k q_f, then O(nf)).
+    pub fn flex_inertia<'a>(&self, f: impl Into<DVectorView<'a, f64>>) -> FlexInertia {
+        let f = f.into();
         let u = &self.undeformed;
         let Some(s) = self.full() else {
-            return (u.c0, u.i0, u.b0.clone());
+            return FlexInertia {
+                c: u.c0,
+                ithth: u.i0,
+                ithf: u.b0.clone(),
+                products: None,
+            };
         };
-        let c = self.first_moment(f);
-        let df = mul3(&s.d, f);
+        let mf: [DVector<f64>; 6] = std::array::from_fn(|k| &s.mij[k] * f);
+        let mtf: [DVector<f64>; 3] = std::array::from_fn(|k| s.mij[k + 3].tr_mul(&f));
+        let c = self.first_moment(&f);
+        let df = mul3(&s.d, &f);
         // U = ∫ρ ū ūᵀ
         let mut uu = Matrix3::zeros();
         uu[(0, 0)] = s.j0;
@@ -433,7 +473,7 @@ impl SpatialBeam {
             uu[(i, 0)] += df[i];
         }
         for (k, &(i, j)) in PAIRS.iter().enumerate() {
-            let e = f.dot(&(&s.mij[k] * f));
+            let e = f.dot(&mf[k]);
             uu[(i, j)] += e;
             if i != j {
                 uu[(j, i)] += e;
@@ -442,10 +482,7 @@ impl SpatialBeam {
         let mut ithth = Matrix3::identity() * uu.trace() - uu;
         ithth[(0, 0)] += s.rotary;
         // I_θf column k = e_x ∫ρI_p θx_k + e_x × D_k + ∫ρ (S q_f) × S_k
-        let skew_part = |k: usize| {
-            let m = &s.mij[k];
-            m.tr_mul(f) - m * f
-        };
+        let skew_part = |k: usize| &mtf[k - 3] - &mf[k];
         let (a12, a02, a01) = (skew_part(5), skew_part(4), skew_part(3));
         let nf = self.nflex();
         let ithf = DMatrix::from_fn(3, nf, |i, k| match i {
@@ -453,7 +490,12 @@ impl SpatialBeam {
             1 => -s.d[(2, k)] - a02[k],
             _ => s.d[(1, k)] + a01[k],
         });
-        (c, ithth, ithf)
+        FlexInertia {
+            c,
+            ithth,
+            ithf,
+            products: Some((mf, mtf)),
+        }
     }
 
     /// Mass matrix over v = [Ṙ, ω, q̇_f], written into `m` (ndof × ndof).
@@ -463,7 +505,7 @@ impl SpatialBeam {
         f: impl Into<DVectorView<'a, f64>>,
         mut m: DMatrixViewMut<f64>,
     ) {
-        let (c, ithth, ithf) = self.inertia_blocks(&f.into());
+        let FlexInertia { c, ithth, ithf, .. } = self.flex_inertia(f);
         let nf = self.nflex();
         m.fill(0.0);
         let mrr = Matrix3::identity() * self.mass;
@@ -500,7 +542,17 @@ impl SpatialBeam {
         f: impl Into<DVectorView<'a, f64>>,
         v: impl Into<DVectorView<'a, f64>>,
     ) -> DVector<f64> {
-        let (f, v) = (f.into(), v.into());
+        let fi = self.flex_inertia(f);
+        self.quadratic_velocity_with(&fi, a, v.into())
+    }
+
+    /// [`SpatialBeam::quadratic_velocity`] with the q_f-dependent inertia given.
+    pub fn quadratic_velocity_with(
+        &self,
+        fi: &FlexInertia,
+        a: &Matrix3<f64>,
+        v: DVectorView<f64>,
+    ) -> DVector<f64> {
         let nf = self.nflex();
         let w = Vector3::new(v[OMEGA], v[OMEGA + 1], v[OMEGA + 2]);
         let fd = v.rows(FLEX, nf);
@@ -513,35 +565,30 @@ impl SpatialBeam {
         let (hr, hw) = match self.full() {
             None => (a * (w.cross(&w.cross(&u.c0))), w.cross(&(u.i0 * w))),
             Some(s) => {
-                let (c, ithth, _) = self.inertia_blocks(&f);
                 let sfd = mul3(&u.sbar, &fd);
-                let hr = a * (w.cross(&w.cross(&c)) + 2.0 * w.cross(&sfd));
-                // G = ∫ρ (S q̇_f) ūᵀ
+                let hr = a * (w.cross(&w.cross(&fi.c)) + 2.0 * w.cross(&sfd));
+                // G = ∫ρ (S q̇_f) ūᵀ: G_ij = q̇_fᵀ M^{ij} q_f
                 let dfd = mul3(&s.d, &fd);
                 let mut g = Matrix3::zeros();
                 for i in 0..3 {
                     g[(i, 0)] += dfd[i];
                     for j in 0..3 {
                         let (k, t) = pair_index(i, j);
-                        let m = &s.mij[k];
-                        g[(i, j)] += if t {
-                            f.dot(&(m * fd))
-                        } else {
-                            fd.dot(&(m * f))
-                        };
+                        g[(i, j)] += fd.dot(fi.product(k, t));
                     }
                 }
                 let rot = s.twist.dot(&fd);
-                let hw = w.cross(&(ithth * w))
+                let hw = w.cross(&(fi.ithth * w))
                     + 2.0 * (w * g.trace() - g * w)
                     + w.cross(&Vector3::x()) * rot;
                 // ∫ρ Sᵀ ω̃² S q_f + 2 ∫ρ Sᵀ ω̃ S q̇_f
                 for (k, &(i, j)) in PAIRS.iter().enumerate() {
-                    let m = &s.mij[k];
                     if i == j {
-                        hf += m * f * ww[(i, i)];
+                        hf.axpy(ww[(i, i)], fi.product(k, false), 1.0);
                     } else {
-                        hf += (m * f + m.tr_mul(&f)) * ww[(i, j)];
+                        hf.axpy(ww[(i, j)], fi.product(k, false), 1.0);
+                        hf.axpy(ww[(i, j)], fi.product(k, true), 1.0);
+                        let m = &s.mij[k];
                         hf += (m * fd - m.tr_mul(&fd)) * (2.0 * wt[(i, j)]);
                     }
                 }
@@ -591,13 +638,40 @@ impl SpatialBeam {
         vd: impl Into<DVectorView<'a, f64>>,
         g: &Vector3<f64>,
     ) -> DVector<f64> {
-        let (f, v, vd) = (f.into(), v.into(), vd.into());
+        let f = f.into();
+        let fi = self.flex_inertia(f);
+        self.residual_with(&fi, a, f, v.into(), vd.into(), g)
+    }
+
+    /// [`SpatialBeam::residual`] with the q_f-dependent inertia `fi` (of this q_f) given; M v̇
+    /// by blocks, M_Rω = −A c̃, M_Rf = A S̄.
+    pub fn residual_with(
+        &self,
+        fi: &FlexInertia,
+        a: &Matrix3<f64>,
+        f: DVectorView<f64>,
+        v: DVectorView<f64>,
+        vd: DVectorView<f64>,
+        g: &Vector3<f64>,
+    ) -> DVector<f64> {
         let nf = self.nflex();
-        let mut r = self.mass_matrix_owned(a, f) * vd + self.quadratic_velocity(a, f, v)
-            - self.gravity_force(a, f, g);
-        let fi = self.internal_force(f, v.rows(FLEX, nf));
+        let sbar = &self.undeformed.sbar;
+        let rd = Vector3::new(vd[0], vd[1], vd[2]);
+        let wd = Vector3::new(vd[OMEGA], vd[OMEGA + 1], vd[OMEGA + 2]);
+        let fdd = vd.rows(FLEX, nf);
+        let rd_body = a.transpose() * rd;
+        let mut r = self.quadratic_velocity_with(fi, a, v);
+        let hr = rd * self.mass - a * fi.c.cross(&wd) + a * mul3(sbar, &fdd) - g * self.mass;
+        let gl = a.transpose() * g;
+        let hw = fi.c.cross(&rd_body) + fi.ithth * wd + &fi.ithf * fdd
+            - self.first_moment(&f).cross(&gl);
+        for i in 0..3 {
+            r[i] += hr[i];
+            r[OMEGA + i] += hw[i];
+        }
         let mut rf = r.rows_mut(FLEX, nf);
-        rf += fi;
+        rf += sbar.tr_mul(&(rd_body - gl)) + fi.ithf.tr_mul(&wd) + &self.mff * fdd;
+        rf += &self.kff * f + &self.dff * v.rows(FLEX, nf);
         r
     }
 

@@ -3,8 +3,8 @@
 
 use super::quaternion::{g_body, rotation};
 use super::rigid_body::RigidBody3;
-use crate::beam::spatial_beam::SpatialBeam;
-use nalgebra::{DMatrix, DVector, DVectorView, Matrix3, Vector3, Vector4};
+use crate::beam::spatial_beam::{FlexInertia, SpatialBeam};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix3, Vector3, Vector4};
 
 /// Coordinates of the frame: R (3) and p (4).
 pub const FRAME: usize = 7;
@@ -116,12 +116,94 @@ impl Body3 {
         zdd: DVectorView<f64>,
         g: &Vector3<f64>,
     ) -> DVector<f64> {
+        let fi = self.flex_inertia(&z);
+        self.residual_with(fi.as_ref(), z, zd, zdd, g)
+    }
+
+    /// A beam's q_f-dependent inertia at z (`None` for a rigid body).
+    fn flex_inertia(&self, z: &DVectorView<f64>) -> Option<FlexInertia> {
+        match self {
+            Body3::Beam(b) => Some(b.flex_inertia(z.rows(FRAME, b.nflex()))),
+            Body3::Rigid(_) => None,
+        }
+    }
+
+    /// [`Body3::residual`] with a beam's q_f-dependent inertia `fi` (of this z) given; T and
+    /// Tᵀ applied by blocks.
+    fn residual_with(
+        &self,
+        fi: Option<&FlexInertia>,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
+        g: &Vector3<f64>,
+    ) -> DVector<f64> {
         let (_, p, a) = frame_of(&z);
-        let t = self.velocity_map(&p);
-        let v = &t * zd;
-        let vd = &t * zdd;
-        let rv = self.residual_v(&a, z.rows(FRAME, self.nflex()), &v, &vd, g);
-        t.tr_mul(&rv)
+        let gp = g_body(&p) * 2.0;
+        let to_v = |x: DVectorView<f64>| {
+            let mut v = DVector::zeros(x.len() - 1);
+            v.rows_mut(0, 3).copy_from(&x.rows(0, 3));
+            v.rows_mut(3, 3).copy_from(&(gp * x.fixed_rows::<4>(3)));
+            v.rows_mut(6, x.len() - FRAME)
+                .copy_from(&x.rows(FRAME, x.len() - FRAME));
+            v
+        };
+        let (v, vd) = (to_v(zd), to_v(zdd));
+        let f = z.rows(FRAME, self.nflex());
+        let rv = match (self, fi) {
+            (Body3::Beam(b), Some(fi)) => {
+                b.residual_with(fi, &a, f, v.rows(0, v.len()), vd.rows(0, vd.len()), g)
+            }
+            _ => self.residual_v(&a, f, &v, &vd, g),
+        };
+        let mut r = DVector::zeros(z.len());
+        r.rows_mut(0, 3).copy_from(&rv.rows(0, 3));
+        r.fixed_rows_mut::<4>(3)
+            .copy_from(&gp.tr_mul(&rv.fixed_rows::<3>(3)));
+        r.rows_mut(FRAME, z.len() - FRAME)
+            .copy_from(&rv.rows(6, z.len() - FRAME));
+        r
+    }
+
+    /// K_t = ∂r/∂z and C_t = ∂r/∂ż by forward differences (step `eps` max(|x|, 1)) into
+    /// n × n views. The residual does not depend on R, so its columns are zero; a beam's
+    /// q_f-dependent inertia is computed once for every column that leaves q_f unchanged.
+    pub fn tangents(
+        &self,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
+        g: &Vector3<f64>,
+        eps: f64,
+        mut kt: DMatrixViewMut<f64>,
+        mut ct: DMatrixViewMut<f64>,
+    ) {
+        let n = self.ncoords();
+        let (mut z, mut zd) = (z.into_owned(), zd.into_owned());
+        let fi = self.flex_inertia(&z.rows(0, n));
+        let r0 = self.residual_with(fi.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
+        kt.columns_mut(0, 3).fill(0.0);
+        for k in 3..n {
+            let x = z[k];
+            let h = eps * x.abs().max(1.0);
+            z[k] = x + h;
+            let zk = z.rows(0, n);
+            let rk = if k < FRAME {
+                self.residual_with(fi.as_ref(), zk, zd.rows(0, n), zdd, g)
+            } else {
+                self.residual_with(self.flex_inertia(&zk).as_ref(), zk, zd.rows(0, n), zdd, g)
+            };
+            z[k] = x;
+            kt.column_mut(k).copy_from(&((rk - &r0) / h));
+        }
+        for k in 0..n {
+            let x = zd[k];
+            let h = eps * x.abs().max(1.0);
+            zd[k] = x + h;
+            let rk = self.residual_with(fi.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
+            zd[k] = x;
+            ct.column_mut(k).copy_from(&((rk - &r0) / h));
+        }
     }
 
     /// Kinetic energy ½ vᵀ M_v v (J).

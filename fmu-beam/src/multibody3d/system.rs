@@ -585,24 +585,15 @@ impl Equations for System3 {
         let g = self.gravity.unwrap_or_default();
         for (i, b) in self.bodies.iter().enumerate() {
             let (o, n) = (self.offsets[i], b.ncoords());
-            let mut z = self.body_coords(i, q).into_owned();
-            let mut zd = self.body_coords(i, v).into_owned();
-            let zdd = self.body_coords(i, a);
-            let r0 = b.residual(z.rows(0, n), zd.rows(0, n), zdd, &g);
-            for k in 0..n {
-                let x = z[k];
-                let h = EPS_FORWARD * x.abs().max(1.0);
-                z[k] = x + h;
-                let rk = b.residual(z.rows(0, n), zd.rows(0, n), zdd, &g);
-                z[k] = x;
-                kt.view_mut((o, o + k), (n, 1)).copy_from(&((rk - &r0) / h));
-                let x = zd[k];
-                let h = EPS_FORWARD * x.abs().max(1.0);
-                zd[k] = x + h;
-                let rk = b.residual(z.rows(0, n), zd.rows(0, n), zdd, &g);
-                zd[k] = x;
-                ct.view_mut((o, o + k), (n, 1)).copy_from(&((rk - &r0) / h));
-            }
+            b.tangents(
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
+                &g,
+                EPS_FORWARD,
+                kt.view_mut((o, o), (n, n)),
+                ct.view_mut((o, o), (n, n)),
+            );
             for k in 0..4 {
                 kt[(o + 3 + k, o + 3 + k)] += 2.0 * lambda[i];
             }
