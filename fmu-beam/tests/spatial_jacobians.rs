@@ -224,3 +224,61 @@ fn load_force_matches_central_differences_of_the_frame_pose() {
         assert!(err < 1e-6, "{err:.2e}");
     }
 }
+
+/// The body tangents (forward differences that update a beam's products column by column)
+/// against central differences of the body residual, for a beam in both inertia models and
+/// a rigid body. The deformation is small, so that the stiffness forces (which cancel in the
+/// differences) leave the round-off of the forward differences below the tolerance.
+#[test]
+fn body_tangents_match_central_differences_of_the_residual() {
+    use fmu_beam::multibody3d::Body3;
+    let mut rng = Random(0x0bad_cafe_f00d_d00d);
+    let sys = system(&mut rng);
+    let mut bodies: Vec<Body3> = sys.bodies.clone();
+    if let Body3::Beam(b) = &sys.bodies[0] {
+        let mut frozen = b.clone();
+        frozen.set_inertia(InertiaModel::Frozen);
+        bodies.push(Body3::Beam(frozen));
+    }
+    let g = Vector3::new(0.3, -1.0, -9.81);
+    for body in &bodies {
+        let n = body.ncoords();
+        let mut z = DVector::from_fn(n, |k, _| rng.next() * if k < 7 { 0.1 } else { 1e-5 });
+        z[3] += 0.9;
+        let zd = DVector::from_fn(n, |_, _| 2.0 * rng.next());
+        let zdd = DVector::from_fn(n, |_, _| 5.0 * rng.next());
+        let (mut kt, mut ct) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        body.tangents(
+            z.rows(0, n),
+            zd.rows(0, n),
+            zdd.rows(0, n),
+            &g,
+            1e-7,
+            kt.view_mut((0, 0), (n, n)),
+            ct.view_mut((0, 0), (n, n)),
+        );
+        let r = |z: &DVector<f64>, zd: &DVector<f64>| {
+            body.residual(z.rows(0, n), zd.rows(0, n), zdd.rows(0, n), &g)
+        };
+        let h = 1e-6;
+        let (mut kd, mut cd) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        for k in 0..n {
+            let (mut zp, mut zm) = (z.clone(), z.clone());
+            zp[k] += h;
+            zm[k] -= h;
+            kd.set_column(k, &((r(&zp, &zd) - r(&zm, &zd)) / (2.0 * h)));
+            let (mut vp, mut vm) = (zd.clone(), zd.clone());
+            vp[k] += h;
+            vm[k] -= h;
+            cd.set_column(k, &((r(&z, &vp) - r(&z, &vm)) / (2.0 * h)));
+        }
+        let (ek, ec) = (relative(&kt, &kd), relative(&ct, &cd));
+        println!("{}: K_t {ek:.1e}, C_t {ec:.1e}", body.name());
+
+        assert!(
+            ek < 1e-5 && ec < 1e-5,
+            "{}: K_t {ek:.2e}, C_t {ec:.2e}",
+            body.name()
+        );
+    }
+}

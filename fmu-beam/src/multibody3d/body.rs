@@ -3,7 +3,7 @@
 
 use super::quaternion::{g_body, rotation};
 use super::rigid_body::RigidBody3;
-use crate::beam::spatial_beam::{FlexInertia, SpatialBeam};
+use crate::beam::spatial_beam::{BeamProducts, SpatialBeam};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix3, Vector3, Vector4};
 
 /// Coordinates of the frame: R (3) and p (4).
@@ -116,23 +116,32 @@ impl Body3 {
         zdd: DVectorView<f64>,
         g: &Vector3<f64>,
     ) -> DVector<f64> {
-        let fi = self.flex_inertia(&z);
-        self.residual_with(fi.as_ref(), z, zd, zdd, g)
+        let pr = self.products(&z, &zd, &zdd);
+        self.residual_with(pr.as_ref(), z, zd, zdd, g)
     }
 
-    /// A beam's q_f-dependent inertia at z (`None` for a rigid body).
-    fn flex_inertia(&self, z: &DVectorView<f64>) -> Option<FlexInertia> {
+    /// A beam's products at (z, ż, z̈) (`None` for a rigid body).
+    fn products(
+        &self,
+        z: &DVectorView<f64>,
+        zd: &DVectorView<f64>,
+        zdd: &DVectorView<f64>,
+    ) -> Option<BeamProducts> {
         match self {
-            Body3::Beam(b) => Some(b.flex_inertia(z.rows(FRAME, b.nflex()))),
+            Body3::Beam(b) => {
+                let nf = b.nflex();
+                let rows = |x: &DVectorView<f64>| x.rows(FRAME, nf).clone_owned();
+                Some(b.products(rows(z).as_view(), rows(zd).as_view(), rows(zdd).as_view()))
+            }
             Body3::Rigid(_) => None,
         }
     }
 
-    /// [`Body3::residual`] with a beam's q_f-dependent inertia `fi` (of this z) given; T and
-    /// Tᵀ applied by blocks.
+    /// [`Body3::residual`] with a beam's products `pr` (of this state) given; T and Tᵀ
+    /// applied by blocks.
     fn residual_with(
         &self,
-        fi: Option<&FlexInertia>,
+        pr: Option<&BeamProducts>,
         z: DVectorView<f64>,
         zd: DVectorView<f64>,
         zdd: DVectorView<f64>,
@@ -150,9 +159,9 @@ impl Body3 {
         };
         let (v, vd) = (to_v(zd), to_v(zdd));
         let f = z.rows(FRAME, self.nflex());
-        let rv = match (self, fi) {
-            (Body3::Beam(b), Some(fi)) => {
-                b.residual_with(fi, &a, f, v.rows(0, v.len()), vd.rows(0, vd.len()), g)
+        let rv = match (self, pr) {
+            (Body3::Beam(b), Some(pr)) => {
+                b.residual_with(pr, &a, f, v.rows(0, v.len()), vd.rows(0, vd.len()), g)
             }
             _ => self.residual_v(&a, f, &v, &vd, g),
         };
@@ -166,8 +175,9 @@ impl Body3 {
     }
 
     /// K_t = ∂r/∂z and C_t = ∂r/∂ż by forward differences (step `eps` max(|x|, 1)) into
-    /// n × n views. The residual does not depend on R, so its columns are zero; a beam's
-    /// q_f-dependent inertia is computed once for every column that leaves q_f unchanged.
+    /// n × n views. The residual depends neither on R nor on Ṙ (their columns are zero); a
+    /// beam's products are computed once and a column that moves q_f or q̇_f updates them by
+    /// one matrix column ([`BeamProducts`]).
     pub fn tangents(
         &self,
         z: DVectorView<f64>,
@@ -180,27 +190,39 @@ impl Body3 {
     ) {
         let n = self.ncoords();
         let (mut z, mut zd) = (z.into_owned(), zd.into_owned());
-        let fi = self.flex_inertia(&z.rows(0, n));
-        let r0 = self.residual_with(fi.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
+        let pr0 = self.products(&z.rows(0, n), &zd.rows(0, n), &zdd);
+        let r0 = self.residual_with(pr0.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
         kt.columns_mut(0, 3).fill(0.0);
+        ct.columns_mut(0, 3).fill(0.0);
         for k in 3..n {
             let x = z[k];
             let h = eps * x.abs().max(1.0);
             z[k] = x + h;
             let zk = z.rows(0, n);
-            let rk = if k < FRAME {
-                self.residual_with(fi.as_ref(), zk, zd.rows(0, n), zdd, g)
-            } else {
-                self.residual_with(self.flex_inertia(&zk).as_ref(), zk, zd.rows(0, n), zdd, g)
+            let rk = match (self, &pr0) {
+                (Body3::Beam(b), Some(pr0)) if k >= FRAME => {
+                    let mut pr = pr0.clone();
+                    b.shift_flex(&mut pr, zk.rows(FRAME, n - FRAME), k - FRAME, h);
+                    self.residual_with(Some(&pr), zk, zd.rows(0, n), zdd, g)
+                }
+                _ => self.residual_with(pr0.as_ref(), zk, zd.rows(0, n), zdd, g),
             };
             z[k] = x;
             kt.column_mut(k).copy_from(&((rk - &r0) / h));
         }
-        for k in 0..n {
+        for k in 3..n {
             let x = zd[k];
             let h = eps * x.abs().max(1.0);
             zd[k] = x + h;
-            let rk = self.residual_with(fi.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
+            let (zk, zdk) = (z.rows(0, n), zd.rows(0, n));
+            let rk = match (self, &pr0) {
+                (Body3::Beam(b), Some(pr0)) if k >= FRAME => {
+                    let mut pr = pr0.clone();
+                    b.shift_flex_rate(&mut pr, k - FRAME, h);
+                    self.residual_with(Some(&pr), zk, zdk, zdd, g)
+                }
+                _ => self.residual_with(pr0.as_ref(), zk, zdk, zdd, g),
+            };
             zd[k] = x;
             ct.column_mut(k).copy_from(&((rk - &r0) / h));
         }
