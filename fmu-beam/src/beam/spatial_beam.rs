@@ -122,7 +122,7 @@ fn pair_index(i: usize, j: usize) -> (usize, bool) {
 /// The q_f-dependent inertia of the model in force, computed once per q_f and shared by the
 /// mass matrix, the quadratic-velocity vector and the residual (and by the tangent columns
 /// that leave q_f unchanged).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct FlexInertia {
     /// Static moment c, I_θθ and I_θf (3 × nf).
     pub c: Vector3<f64>,
@@ -149,13 +149,62 @@ impl FlexInertia {
 /// inertia, K_ff q_f, D_ff q̇_f, m_ff q̈_f and (full model) (M^k − M^kᵀ) q̇_f for k = 3, 4, 5.
 /// A tangent column that moves one coordinate updates them by one matrix column
 /// ([`SpatialBeam::shift_flex`], [`SpatialBeam::shift_flex_rate`]): O(nf) instead of O(nf²).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct BeamProducts {
     pub inertia: FlexInertia,
     kf: DVector<f64>,
     dfd: DVector<f64>,
     mfdd: DVector<f64>,
     skew_fd: Vec<DVector<f64>>,
+}
+
+/// Copies in place on `clone_from` (a tangent column starts from the state's products without
+/// allocating).
+impl Clone for FlexInertia {
+    fn clone(&self) -> FlexInertia {
+        FlexInertia {
+            c: self.c,
+            ithth: self.ithth,
+            ithf: self.ithf.clone(),
+            products: self.products.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &FlexInertia) {
+        self.c = source.c;
+        self.ithth = source.ithth;
+        self.ithf.copy_from(&source.ithf);
+        match (self.products.as_mut(), source.products.as_ref()) {
+            (Some((mf, mtf)), Some((smf, smtf))) => {
+                mf.iter_mut().zip(smf).for_each(|(x, y)| x.copy_from(y));
+                mtf.iter_mut().zip(smtf).for_each(|(x, y)| x.copy_from(y));
+            }
+            _ => self.products = source.products.clone(),
+        }
+    }
+}
+
+impl Clone for BeamProducts {
+    fn clone(&self) -> BeamProducts {
+        BeamProducts {
+            inertia: self.inertia.clone(),
+            kf: self.kf.clone(),
+            dfd: self.dfd.clone(),
+            mfdd: self.mfdd.clone(),
+            skew_fd: self.skew_fd.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &BeamProducts) {
+        self.inertia.clone_from(&source.inertia);
+        self.kf.copy_from(&source.kf);
+        self.dfd.copy_from(&source.dfd);
+        self.mfdd.copy_from(&source.mfdd);
+        self.skew_fd
+            .iter_mut()
+            .zip(&source.skew_fd)
+            .for_each(|(x, y)| x.copy_from(y));
+    }
 }
 
 /// Inertia of the undeformed beam in its frame: everything [`InertiaModel::Frozen`] needs, and
@@ -474,20 +523,24 @@ impl SpatialBeam {
                 products: None,
             };
         };
-        let mf: [DVector<f64>; 6] = std::array::from_fn(|k| &s.mij[k] * f);
-        let mtf: [DVector<f64>; 3] = std::array::from_fn(|k| s.mij[k + 3].tr_mul(&f));
-        self.full_inertia(s, f, mf, mtf)
+        let mut fi = FlexInertia {
+            c: Vector3::zeros(),
+            ithth: Matrix3::zeros(),
+            ithf: DMatrix::zeros(3, self.nflex()),
+            products: Some((
+                std::array::from_fn(|k| &s.mij[k] * f),
+                std::array::from_fn(|k| s.mij[k + 3].tr_mul(&f)),
+            )),
+        };
+        self.assemble_full(s, f, &mut fi);
+        fi
     }
 
-    /// The full model's inertia at q_f from its products M^k q_f (`mf`), M^kᵀ q_f (`mtf`).
-    fn full_inertia(
-        &self,
-        s: &ShapeIntegrals,
-        f: DVectorView<f64>,
-        mf: [DVector<f64>; 6],
-        mtf: [DVector<f64>; 3],
-    ) -> FlexInertia {
-        let c = self.first_moment(&f);
+    /// The full model's c, I_θθ and I_θf at q_f from the products M^k q_f, M^kᵀ q_f in `fi`.
+    fn assemble_full(&self, s: &ShapeIntegrals, f: DVectorView<f64>, fi: &mut FlexInertia) {
+        let Some((mf, mtf)) = fi.products.as_ref() else {
+            unreachable!("the full model keeps its products")
+        };
         let df = mul3(&s.d, &f);
         // U = ∫ρ ū ūᵀ
         let mut uu = Matrix3::zeros();
@@ -505,21 +558,15 @@ impl SpatialBeam {
         }
         let mut ithth = Matrix3::identity() * uu.trace() - uu;
         ithth[(0, 0)] += s.rotary;
-        // I_θf column k = e_x ∫ρI_p θx_k + e_x × D_k + ∫ρ (S q_f) × S_k
-        let skew_part = |k: usize| &mtf[k - 3] - &mf[k];
-        let (a12, a02, a01) = (skew_part(5), skew_part(4), skew_part(3));
-        let nf = self.nflex();
-        let ithf = DMatrix::from_fn(3, nf, |i, k| match i {
-            0 => s.twist[k] + a12[k],
-            1 => -s.d[(2, k)] - a02[k],
-            _ => s.d[(1, k)] + a01[k],
-        });
-        FlexInertia {
-            c,
-            ithth,
-            ithf,
-            products: Some((mf, mtf)),
+        // I_θf column k = e_x ∫ρI_p θx_k + e_x × D_k + ∫ρ (S q_f) × S_k, the last from the
+        // skew parts M^kᵀ q_f − M^k q_f of the pairs (1, 2), (0, 2), (0, 1)
+        for k in 0..self.nflex() {
+            fi.ithf[(0, k)] = s.twist[k] + (mtf[2][k] - mf[5][k]);
+            fi.ithf[(1, k)] = -s.d[(2, k)] - (mtf[1][k] - mf[4][k]);
+            fi.ithf[(2, k)] = s.d[(1, k)] + (mtf[0][k] - mf[3][k]);
         }
+        fi.c = self.first_moment(&f);
+        fi.ithth = ithth;
     }
 
     /// All products of the residual at (q_f, q̇_f, q̈_f).
@@ -548,7 +595,7 @@ impl SpatialBeam {
     pub fn shift_flex(&self, pr: &mut BeamProducts, f: DVectorView<f64>, k: usize, h: f64) {
         pr.kf.axpy(h, &self.kff.column(k), 1.0);
         let Some(s) = self.full() else { return };
-        let Some((mut mf, mut mtf)) = pr.inertia.products.take() else {
+        let Some((mf, mtf)) = pr.inertia.products.as_mut() else {
             unreachable!("the full model keeps its products")
         };
         for j in 0..6 {
@@ -557,7 +604,7 @@ impl SpatialBeam {
         for j in 0..3 {
             mtf[j].axpy(h, &s.mij[j + 3].row(k).transpose(), 1.0);
         }
-        pr.inertia = self.full_inertia(s, f, mf, mtf);
+        self.assemble_full(s, f, &mut pr.inertia);
     }
 
     /// Updates `pr` for q̇_f moved by `h` in coordinate `k`.

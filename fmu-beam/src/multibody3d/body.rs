@@ -130,8 +130,7 @@ impl Body3 {
         match self {
             Body3::Beam(b) => {
                 let nf = b.nflex();
-                let rows = |x: &DVectorView<f64>| x.rows(FRAME, nf).clone_owned();
-                Some(b.products(rows(z).as_view(), rows(zd).as_view(), rows(zdd).as_view()))
+                Some(b.products(z.rows(FRAME, nf), zd.rows(FRAME, nf), zdd.rows(FRAME, nf)))
             }
             Body3::Rigid(_) => None,
         }
@@ -192,6 +191,7 @@ impl Body3 {
         let (mut z, mut zd) = (z.into_owned(), zd.into_owned());
         let pr0 = self.products(&z.rows(0, n), &zd.rows(0, n), &zdd);
         let r0 = self.residual_with(pr0.as_ref(), z.rows(0, n), zd.rows(0, n), zdd, g);
+        let mut pr = pr0.clone();
         kt.columns_mut(0, 3).fill(0.0);
         ct.columns_mut(0, 3).fill(0.0);
         for k in 3..n {
@@ -201,9 +201,10 @@ impl Body3 {
             let zk = z.rows(0, n);
             let rk = match (self, &pr0) {
                 (Body3::Beam(b), Some(pr0)) if k >= FRAME => {
-                    let mut pr = pr0.clone();
-                    b.shift_flex(&mut pr, zk.rows(FRAME, n - FRAME), k - FRAME, h);
-                    self.residual_with(Some(&pr), zk, zd.rows(0, n), zdd, g)
+                    let pr = pr.as_mut().expect("a beam has products");
+                    pr.clone_from(pr0);
+                    b.shift_flex(pr, zk.rows(FRAME, n - FRAME), k - FRAME, h);
+                    self.residual_with(Some(pr), zk, zd.rows(0, n), zdd, g)
                 }
                 _ => self.residual_with(pr0.as_ref(), zk, zd.rows(0, n), zdd, g),
             };
@@ -217,9 +218,10 @@ impl Body3 {
             let (zk, zdk) = (z.rows(0, n), zd.rows(0, n));
             let rk = match (self, &pr0) {
                 (Body3::Beam(b), Some(pr0)) if k >= FRAME => {
-                    let mut pr = pr0.clone();
-                    b.shift_flex_rate(&mut pr, k - FRAME, h);
-                    self.residual_with(Some(&pr), zk, zdk, zdd, g)
+                    let pr = pr.as_mut().expect("a beam has products");
+                    pr.clone_from(pr0);
+                    b.shift_flex_rate(pr, k - FRAME, h);
+                    self.residual_with(Some(pr), zk, zdk, zdd, g)
                 }
                 _ => self.residual_with(pr0.as_ref(), zk, zdk, zdd, g),
             };
