@@ -53,7 +53,7 @@ fn system(rng: &mut Random) -> System3 {
         rho: 7800.0,
         e: 2e11,
         g: 8e10,
-        section: section.clone(),
+        section,
         rayleigh_alpha: 0.0,
         rayleigh_beta: 0.0,
         inertia: InertiaModel::Full,

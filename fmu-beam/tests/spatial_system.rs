@@ -287,9 +287,8 @@ fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
 /// time discretization between the rigid and flexible runs at any practical fixed step (at
 /// h = 2.5e-4 and 1e-4 the "lag" scatters by ±5e-7 s with the element count). It is resolved
 /// with the error control at tolerance 1e-9 (the rigid twin moves by 3.4e-6 rad, 3.6e-7 s,
-/// from tolerance 1e-8 to 1e-9: that is the uncertainty of the figure). Slow (≈ 2 min).
+/// from tolerance 1e-8 to 1e-9: that is the uncertainty of the figure). About 15 s in release.
 #[test]
-#[ignore = "slow (about 2 min at tolerance 1e-9): cargo test --release -- --ignored c6"]
 fn c6_flexible_pendulum_lags_its_rigid_twin() {
     let settings = Settings {
         adaptive: true,

@@ -130,8 +130,11 @@ pub struct FlexInertia {
     pub ithf: DMatrix<f64>,
     /// Full model: M^k q_f for k in [`PAIRS`], and M^kᵀ q_f for the three off the diagonal
     /// (k = 3, 4, 5); `None` in the frozen model.
-    products: Option<([DVector<f64>; 6], [DVector<f64>; 3])>,
+    products: Option<Products>,
 }
+
+/// M^k q_f for k in [`PAIRS`] and M^kᵀ q_f for k = 3, 4, 5.
+type Products = ([DVector<f64>; 6], [DVector<f64>; 3]);
 
 impl FlexInertia {
     /// M^{ij} q_f (`transposed`: M^{ij}ᵀ q_f = M^{ji} q_f) of the full model.

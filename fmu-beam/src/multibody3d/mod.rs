@@ -21,10 +21,13 @@
 //! residual in (q, q', q'') is therefore Tᵀ r_v(A(p), q_f, T q', T q''), with
 //! T = diag(I, 2 G(p), I) and r_v the body's residual over v = [Ṙ, ω, q̇_f].
 //!
-//! Tangents, constraint Jacobians and the acceleration bias are finite differences: K_t and
-//! C_t per body over its own coordinates (the residual is block-local), G per joint over the
-//! coordinates of its two bodies (central differences), the bias by a second directional
-//! difference of g along q' plus the drive law's second derivative. The norm rows are exact.
+//! The constraint Jacobian is in closed form: each column is the joint rows' derivative along
+//! the frame-pose derivatives of one coordinate ([`frame::Frame3::pose_derivatives`],
+//! [`joint::Joint3::rows_acceleration`]); so are the joint-coordinate gradient and the load
+//! forces. K_t and C_t are forward differences per body over its own coordinates (the residual
+//! is block-local), a beam's matrix–vector products updated by one column per q_f or q̇_f
+//! column; the bias is a second directional difference of g along q' plus the drive law's
+//! second derivative. The norm rows are exact.
 
 pub mod body;
 pub mod build;
