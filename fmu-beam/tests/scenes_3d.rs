@@ -237,35 +237,49 @@ const FIXED: [(&str, f64); 3] = [
     ("solver.tolerance", 1e-10),
 ];
 
-/// Hinge angle of a C6 scene at 1 s and the wall time of the run.
-fn c6_angle(s: Scene) -> (f64, f64) {
+/// Hinge angle of a C6 scene at 1 s, the largest tip deflection (local z, in the plane of
+/// the swing) over the run, and the wall time of the run.
+fn c6_run(s: Scene) -> (f64, f64, f64) {
     let t0 = std::time::Instant::now();
-    let r = run(s, &FIXED, &["hinge.angle"], 0.01, 1.0);
-    (r.last(1), t0.elapsed().as_secs_f64())
+    let r = run(
+        s,
+        &FIXED,
+        &["hinge.angle", "beam.tip.deflection_z"],
+        0.01,
+        1.0,
+    );
+    let sag = r.column(2).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (r.last(1), sag, t0.elapsed().as_secs_f64())
 }
 
-/// The fast variants as scenes: the matrix-file beam (the element's own matrices) equals the
-/// frozen one-element beam to 1e-9 rad, and frozen inertia stays within 1e-5 rad of the full
-/// model on C6 at 1 s: below the flexibility's own effect (the lag of 2.4e-6 s is 2.3e-5 rad),
-/// so the variant keeps what the flexible model is for. Times are one run each; `make bench`
-/// has the repeated measurement.
+/// The fast variants as scenes. The matrix-file beam (the element's own matrices) equals the
+/// frozen one-element beam to 1e-9 rad. Frozen inertia against the full model on C6: the
+/// deflection the flexible model is there to compute (the tip's, largest over the swing)
+/// within 1 % (measured 8e-9), the hinge angle at 1 s within 2e-6 rad (measured 7.7e-7 rad,
+/// 1.2e-6 of the swing). On C6 flexibility
+/// itself moves the swing by only 5.4e-7 rad (a lag of 5.7e-8 s, `spatial_system.rs`), so
+/// the angle tells little here; `make bench`'s spin-up shows where frozen inertia loses
+/// (7.5 % of the tip deflection). Times are one run each; `make bench` repeats them.
 #[test]
 fn fast_variant_scenes_match_the_full_model() {
-    let (full, t_full) = c6_angle(scene("pendulum_3d.toml"));
-    let (frozen, t_frozen) = c6_angle(scene("pendulum_3d_frozen.toml"));
-    let (matrix, t_matrix) = c6_angle(scene("pendulum_3d_matrix.toml"));
+    let (full, sag_full, t_full) = c6_run(scene("pendulum_3d.toml"));
+    let (frozen, sag_frozen, t_frozen) = c6_run(scene("pendulum_3d_frozen.toml"));
+    let (matrix, _, t_matrix) = c6_run(scene("pendulum_3d_matrix.toml"));
     let mut one = scene("pendulum_3d_frozen.toml");
     one.beams[0].elements = Some(1);
-    let (one_el, t_one) = c6_angle(one);
+    let (one_el, _, t_one) = c6_run(one);
     println!(
-        "C6 hinge angle at 1 s (fixed step 2e-4 s): full {full:.9} ({t_full:.2} s), frozen \
-         {frozen:.9} ({t_frozen:.2} s, error {:.1e}), matrix file {matrix:.9} ({t_matrix:.2} s), \
-         frozen 1 element {one_el:.9} ({t_one:.2} s, error {:.1e})",
+        "C6 (fixed step 2e-4 s): hinge angle at 1 s: full {full:.9} ({t_full:.2} s), frozen \
+         {frozen:.9} ({t_frozen:.2} s, {:+.1e}), matrix file {matrix:.9} ({t_matrix:.2} s), \
+         frozen 1 element {one_el:.9} ({t_one:.2} s, {:+.1e}); largest tip deflection: full \
+         {sag_full:.4e} m, frozen {sag_frozen:.4e} m ({:+.2e} relative)",
         frozen - full,
-        one_el - full
+        one_el - full,
+        sag_frozen / sag_full - 1.0
     );
     assert!((matrix - one_el).abs() < 1e-9, "{matrix} vs {one_el}");
-    assert!((frozen - full).abs() < 1e-5, "{frozen} vs {full}");
+    assert!((sag_frozen / sag_full - 1.0).abs() < 0.01);
+    assert!((frozen - full).abs() < 2e-6, "{frozen} vs {full}");
 }
 
 /// A 3D scene's canonical text (what the FMU carries) reads back to the same scene, matrix
