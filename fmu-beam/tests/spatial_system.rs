@@ -224,23 +224,28 @@ fn c2_in_3d_agrees_with_the_planar_engine() {
     );
 }
 
-/// Case C6 (3D paper §5.2): C5's beam, L = 0.2, revolute about the world y axis at flange a,
-/// horizontal along X, gravity along −Z. `elements = None` gives the rigid twin (same mass,
-/// same inertia of the undeformed beam). Returns the hinge angle at 1 s and its rate.
-fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
-    let section = SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7);
-    let props = SpatialBeamProps {
-        length: 0.2,
-        elements: elements.unwrap_or(1),
+/// C5's beam (its table's section, steel) of `length`, `elements` per frame, damped by a
+/// mass-proportional Rayleigh `alpha`: the beam of C5 and C6.
+fn c5_beam(length: f64, elements: usize, alpha: f64) -> SpatialBeamProps {
+    SpatialBeamProps {
+        length,
+        elements,
         frame: FrameKind::Tangent,
         rho: 7800.0,
         e: 210e9,
         g: 8.077e10,
-        section,
-        rayleigh_alpha: 0.0,
+        section: SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7),
+        rayleigh_alpha: alpha,
         rayleigh_beta: 0.0,
         inertia: InertiaModel::Full,
-    };
+    }
+}
+
+/// Case C6 (3D paper §5.2): C5's beam, L = 0.2, revolute about the world y axis at flange a,
+/// horizontal along X, gravity along −Z. `elements = None` gives the rigid twin (same mass,
+/// same inertia of the undeformed beam). Returns the hinge angle at 1 s and its rate.
+fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
+    let props = c5_beam(0.2, elements.unwrap_or(1), 0.0);
     let mut sys = System3::new(Some(Vector3::new(0.0, 0.0, -9.81)));
     // joint axes: z along world y (x0 = X, y0 = −Z)
     let axes = Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0);
@@ -317,19 +322,7 @@ fn c6_exact_rigid() -> (f64, f64) {
 fn c6_flexible_pendulum_lags_its_rigid_twin() {
     let (exact, rate) = c6_exact_rigid();
     // the rigid twin's inertia about the hinge axis (world y = the beam's y) and its mass
-    let section = SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7);
-    let props = SpatialBeamProps {
-        length: 0.2,
-        elements: 1,
-        frame: FrameKind::Tangent,
-        rho: 7800.0,
-        e: 210e9,
-        g: 8.077e10,
-        section,
-        rayleigh_alpha: 0.0,
-        rayleigh_beta: 0.0,
-        inertia: InertiaModel::Full,
-    };
+    let props = c5_beam(0.2, 1, 0.0);
     let beam = fmu_beam::beam::spatial_beam::SpatialBeam::new("beam", &props);
     let m = beam.mass;
     let j_hinge = beam.undeformed.i0[(1, 1)];
@@ -373,19 +366,7 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
 /// held 1.5 s, q_f damped. Returns the tip's distance from the root / L and its rotation
 /// about the axis / 2π, averaged over the last 0.5 s (the mean tip position, then its norm).
 fn c5(k: usize, axis: usize) -> (f64, f64) {
-    let section = SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7);
-    let props = SpatialBeamProps {
-        length: 1.0,
-        elements: 1,
-        frame: FrameKind::Tangent,
-        rho: 7800.0,
-        e: 210e9,
-        g: 8.077e10,
-        section,
-        rayleigh_alpha: 200.0,
-        rayleigh_beta: 0.0,
-        inertia: InertiaModel::Full,
-    };
+    let props = c5_beam(1.0, 1, 200.0);
     let ei = 210e9 * if axis == 1 { 4.138e-7 } else { 4.19e-8 };
     let mut sys = System3::new(None);
     let g = sys.add_beam("beam", &props, k, Vector3::zeros(), Matrix3::identity());
