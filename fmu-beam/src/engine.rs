@@ -59,6 +59,10 @@ pub struct Engine {
     model: Option<Model>,
 }
 
+/// What the validity monitor reads of a beam: its name, length and chord (root to tip), and
+/// per floating frame its name, length and largest transverse deflection.
+type BeamExtent = (String, f64, f64, Vec<(String, f64, f64)>);
+
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 /// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
 const STRETCH_LIMIT: f64 = 0.01;
@@ -442,51 +446,79 @@ impl Engine {
         result
     }
 
-    /// The validity monitor: a single-frame beam assumes small deformation. Beyond 5 % of its
-    /// length it warns once; beyond its length the solution has run away (a linear beam spun
-    /// above its first bending frequency) and the step is refused.
+    /// The validity monitor: a floating frame assumes small deformation. Beyond 5 % of its
+    /// length it warns once per beam; beyond its length the solution has run away (a linear
+    /// beam spun above its first bending frequency) and the step is refused, as it is when a
+    /// beam's chord (root to tip) is longer than the beam.
     fn monitor_validity(&mut self) -> Result<(), EngineError> {
         let m = self.model.as_ref().expect("model built");
         let (q, t) = (&m.state.q, m.state.t);
-        let sys = match &m.system {
-            Mechanics::Planar(sys, _) => sys,
-            Mechanics::Spatial(sys, index) => return spatial_validity(sys, index, q, t),
-        };
-        for (g, grp) in sys.beams.iter().enumerate() {
+        let mut beams: Vec<BeamExtent> = Vec::new();
+        match &m.system {
+            Mechanics::Planar(sys, _) => {
+                for (g, grp) in sys.beams.iter().enumerate() {
+                    let z0 = sys.body_coords(grp.bodies.start, q);
+                    let (tip, _) = sys.beam_tip(g, q);
+                    let chord = (tip - nalgebra::Vector2::new(z0[0], z0[1])).norm();
+                    let frames = grp
+                        .bodies
+                        .clone()
+                        .filter_map(|body| {
+                            let b = sys.beam(body)?;
+                            let defl = b.largest_transverse(sys.body_coords(body, q));
+                            Some((b.name.clone(), b.length, defl))
+                        })
+                        .collect();
+                    beams.push((grp.name.clone(), grp.length, chord, frames));
+                }
+            }
+            Mechanics::Spatial(sys, index) => {
+                for (grp, &(root, tip)) in sys.beams.iter().zip(&index.beam_frames) {
+                    let chord = (sys.frame_pose(tip, q).0 - sys.frame_pose(root, q).0).norm();
+                    let frames = grp
+                        .bodies
+                        .clone()
+                        .filter_map(|body| {
+                            let crate::multibody3d::Body3::Beam(b) = &sys.bodies[body] else {
+                                return None;
+                            };
+                            let z = sys.body_coords(body, q);
+                            let defl = b.largest_transverse(z.rows(7, b.nflex()));
+                            Some((b.name.clone(), b.length, defl))
+                        })
+                        .collect();
+                    beams.push((grp.name.clone(), grp.length, chord, frames));
+                }
+            }
+        }
+        for (g, (beam, length, chord, frames)) in beams.into_iter().enumerate() {
             // a beam does not stretch: a chord longer than the beam is a model out of range
-            let z0 = sys.body_coords(grp.bodies.start, q);
-            let (tip, _) = sys.beam_tip(g, q);
-            let chord = (tip - nalgebra::Vector2::new(z0[0], z0[1])).norm();
-            if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * grp.length {
+            if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * length {
                 return Err(EngineError::Stretched {
-                    beam: grp.name.clone(),
+                    beam,
                     t,
                     chord,
-                    length: grp.length,
+                    length,
                 });
             }
             // each floating frame's own deformation must stay small against its length
-            for body in grp.bodies.clone() {
-                let Some(b) = sys.beam(body) else { continue };
-                let defl = b.largest_transverse(sys.body_coords(body, q));
-                if defl > b.length || !defl.is_finite() {
+            for (frame, length, defl) in frames {
+                if defl > length || !defl.is_finite() {
                     return Err(EngineError::Runaway {
-                        beam: b.name.clone(),
+                        beam: frame,
                         t,
                         deflection: defl,
-                        length: b.length,
+                        length,
                     });
                 }
-                if defl > 0.05 * b.length && !self.warned[g] {
+                if defl > 0.05 * length && !self.warned[g] {
                     self.warned[g] = true;
                     self.messages.push(format!(
-                        "beam '{}': deflection {defl:.3e} m of frame '{}' at t = {t} s is {:.1} % \
-                         of the frame's length, beyond the small-deformation range of a floating \
-                         frame; use (more) substructures (or geometric_stiffening for a spinning \
-                         beam)",
-                        grp.name,
-                        b.name,
-                        100.0 * defl / b.length
+                        "beam '{beam}': deflection {defl:.3e} m of frame '{frame}' at t = {t} s \
+                         is {:.1} % of the frame's length, beyond the small-deformation range of \
+                         a floating frame; use (more) substructures (or geometric_stiffening for \
+                         a spinning beam)",
+                        100.0 * defl / length
                     ));
                 }
             }
@@ -652,28 +684,6 @@ fn law_mut(s: &mut Scene, joint: usize) -> &mut crate::scene::LawSpec {
         .as_mut()
         .expect("drive parameters exist only for drives")
         .law
-}
-
-/// The spatial validity monitor: a chord longer than the beam (by [`STRETCH_LIMIT`]) is a
-/// model out of range. (The per-frame deflection warning is planar only.)
-fn spatial_validity(
-    sys: &System3,
-    index: &crate::multibody3d::build::SceneIndex,
-    q: &nalgebra::DVector<f64>,
-    t: f64,
-) -> Result<(), EngineError> {
-    for (grp, &(root, tip)) in sys.beams.iter().zip(&index.beam_frames) {
-        let chord = (sys.frame_pose(tip, q).0 - sys.frame_pose(root, q).0).norm();
-        if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * grp.length {
-            return Err(EngineError::Stretched {
-                beam: grp.name.clone(),
-                t,
-                chord,
-                length: grp.length,
-            });
-        }
-    }
-    Ok(())
 }
 
 /// A 3D output of a planar model (a 3D scene reduced to the plane): nothing leaves the plane.

@@ -477,6 +477,17 @@ impl SpatialBeam {
         self.inertia
     }
 
+    /// Largest transverse nodal displacement √(v² + w²) of the deformation `f` (m): how far
+    /// the beam has bent away from its floating frame's axis.
+    pub fn largest_transverse(&self, f: DVectorView<f64>) -> f64 {
+        (0..=self.elements)
+            .map(|j| {
+                let c = |p: usize| self.flex_index(NODE_DOFS * j + p).map_or(0.0, |k| f[k]);
+                c(V).hypot(c(W))
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Number of deformation coordinates nf.
     pub fn nflex(&self) -> usize {
         self.kept.len()
