@@ -570,9 +570,26 @@ pub fn study(
 
 /// A point that was not run.
 fn skeleton(case: &Case, formulation: &str, setting: Setting) -> Point {
+    blank(
+        case.name,
+        case.outputs[0],
+        case.outputs.len(),
+        formulation,
+        setting,
+    )
+}
+
+/// A point not run yet: `outputs` compared outputs, the first named `output`.
+fn blank(
+    case: &'static str,
+    output: &'static str,
+    outputs: usize,
+    formulation: &str,
+    setting: Setting,
+) -> Point {
     Point {
-        case: case.name,
-        output: case.outputs[0],
+        case,
+        output,
         formulation: formulation.to_string(),
         setting,
         effects: "all".into(),
@@ -582,8 +599,8 @@ fn skeleton(case: &Case, formulation: &str, setting: Setting) -> Point {
         steps: 0,
         newton: 0,
         factorizations: 0,
-        errors: vec![f64::NAN; case.outputs.len()],
-        relative: vec![f64::NAN; case.outputs.len()],
+        errors: vec![f64::NAN; outputs],
+        relative: vec![f64::NAN; outputs],
         missing: Vec::new(),
         check: None,
         values: Vec::new(),

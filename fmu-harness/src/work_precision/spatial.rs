@@ -11,8 +11,8 @@
 
 use super::report;
 use super::{
-    thread_cpu_seconds, timed, timed_together, Options, Point, Run, Series, Setting, Status, Timed,
-    EFFECTS_REPEATS, FIXED_STEP_NEWTON_TOLERANCE,
+    blank, thread_cpu_seconds, timed, timed_together, Options, Point, Run, Series, Setting, Status,
+    Timed, EFFECTS_REPEATS, FIXED_STEP_NEWTON_TOLERANCE,
 };
 use crate::error::HarnessError;
 use fmu_beam::beam::matrix_file::{self, MatrixFile};
@@ -496,26 +496,9 @@ fn spin_up(scene: &Scene, model: Model, setting: Setting) -> Result<Series, Engi
     })
 }
 
-/// A point not run yet.
+/// A point not run yet, with three compared outputs.
 fn point(case: &'static str, output: &'static str, formulation: &str, setting: Setting) -> Point {
-    Point {
-        case,
-        output,
-        formulation: formulation.to_string(),
-        setting,
-        effects: "all".into(),
-        status: Status::Ok,
-        runs: 0,
-        seconds: [f64::NAN; 3],
-        steps: 0,
-        newton: 0,
-        factorizations: 0,
-        errors: vec![f64::NAN; 3],
-        relative: vec![f64::NAN; 3],
-        missing: Vec::new(),
-        check: None,
-        values: Vec::new(),
-    }
+    blank(case, output, 3, formulation, setting)
 }
 
 /// Puts a timing's counters and CPU seconds into `p`; returns the series (None: failed).
