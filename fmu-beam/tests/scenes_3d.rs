@@ -334,6 +334,17 @@ fn the_3d_pendulum_modes_match_beam_theory() {
     assert!((f[3] / pinned_free_xz - 1.0).abs() < 0.01, "{}", f[3]);
 }
 
+/// A 3D cantilever along world y (L = 0.5 m, 4 elements, C5's section), its section's z axis
+/// along world x, damped (α = 400 /s), with an input load at its tip.
+const CANTILEVER_3D: &str = "name = \"c\"\ndimensions = 3\n[experiment]\nstop_time = 2.0\n\
+    [solver]\nadaptive = false\nmax_step = 1e-3\ntolerance = 1e-10\n\
+    [[beam]]\nname = \"beam\"\nlength = 0.5\nelements = 4\naxis = [0, 1, 0]\n\
+    normal = [1, 0, 0]\nmaterial = { rho = 7800.0, E = 2.1e11, G = 8.077e10 }\n\
+    section = { A = 1.257e-3, Iy = 4.138e-7, Iz = 4.19e-8, It = 1.33242e-7 }\n\
+    rayleigh = { alpha = 400.0 }\n\
+    [[joint]]\nname = \"clamp\"\ntype = \"weld\"\nframes = [\"world\", \"beam.a\"]\n\
+    [[load]]\nname = \"tip\"\nframe = \"beam.b\"\ninput = true\n";
+
 /// A 3D cantilever along world y with its section's z axis along world x, loaded at the tip
 /// through FMU inputs (a force along world x = the local z axis, a torque about world y = the
 /// beam axis): the static deflection along local z is F L³ / (3 E I_y) (bending in x–z) and
@@ -341,15 +352,7 @@ fn the_3d_pendulum_modes_match_beam_theory() {
 /// The small load keeps the response linear (deflection 1e-4 L); Rayleigh damping settles it.
 #[test]
 fn a_3d_cantilever_under_input_loads_deflects_and_twists_as_beam_theory_says() {
-    let text = "name = \"c\"\ndimensions = 3\n[experiment]\nstop_time = 2.0\n\
-        [solver]\nadaptive = false\nmax_step = 1e-3\ntolerance = 1e-10\n\
-        [[beam]]\nname = \"beam\"\nlength = 0.5\nelements = 4\naxis = [0, 1, 0]\n\
-        normal = [1, 0, 0]\nmaterial = { rho = 7800.0, E = 2.1e11, G = 8.077e10 }\n\
-        section = { A = 1.257e-3, Iy = 4.138e-7, Iz = 4.19e-8, It = 1.33242e-7 }\n\
-        rayleigh = { alpha = 400.0 }\n\
-        [[joint]]\nname = \"clamp\"\ntype = \"weld\"\nframes = [\"world\", \"beam.a\"]\n\
-        [[load]]\nname = \"tip\"\nframe = \"beam.b\"\ninput = true\n";
-    let s = Scene::from_toml_str(text, "cantilever.toml").expect("valid");
+    let s = Scene::from_toml_str(CANTILEVER_3D, "cantilever.toml").expect("valid");
     assert!(
         s.planar_reduction().is_err(),
         "input loads keep the 3D element"
@@ -457,15 +460,7 @@ fn a_3d_model_restores_its_state_bit_for_bit_and_survives_bad_input() {
 /// the run goes on.
 #[test]
 fn a_3d_frame_bent_past_the_small_deformation_range_is_warned_about() {
-    let text = "name = \"c\"\ndimensions = 3\n[experiment]\nstop_time = 1.0\n\
-        [solver]\nadaptive = false\nmax_step = 1e-3\n\
-        [[beam]]\nname = \"beam\"\nlength = 0.5\nelements = 4\naxis = [0, 1, 0]\n\
-        normal = [1, 0, 0]\nmaterial = { rho = 7800.0, E = 2.1e11, G = 8.077e10 }\n\
-        section = { A = 1.257e-3, Iy = 4.138e-7, Iz = 4.19e-8, It = 1.33242e-7 }\n\
-        rayleigh = { alpha = 400.0 }\n\
-        [[joint]]\nname = \"clamp\"\ntype = \"weld\"\nframes = [\"world\", \"beam.a\"]\n\
-        [[load]]\nname = \"tip\"\nframe = \"beam.b\"\ninput = true\n";
-    let mut e = Engine::new(Scene::from_toml_str(text, "cantilever.toml").expect("valid"));
+    let mut e = Engine::new(Scene::from_toml_str(CANTILEVER_3D, "cantilever.toml").expect("valid"));
     // F L³ / (3 E I_y) = 8 % of L
     let force = 0.08 * 0.5 * 3.0 * 2.1e11 * 4.138e-7 / 0.125;
     e.set_real(vr(&e, "tip.fx"), force).unwrap();
