@@ -59,10 +59,6 @@ pub struct Engine {
     model: Option<Model>,
 }
 
-/// What the validity monitor reads of a beam: its name, length and chord (root to tip), and
-/// per floating frame its name, length and largest transverse deflection.
-type BeamExtent = (String, f64, f64, Vec<(String, f64, f64)>);
-
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 /// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
 const STRETCH_LIMIT: f64 = 0.01;
@@ -451,75 +447,43 @@ impl Engine {
     /// beam spun above its first bending frequency) and the step is refused, as it is when a
     /// beam's chord (root to tip) is longer than the beam.
     fn monitor_validity(&mut self) -> Result<(), EngineError> {
-        let m = self.model.as_ref().expect("model built");
+        let Engine {
+            model,
+            warned,
+            messages,
+            ..
+        } = self;
+        let m = model.as_ref().expect("model built");
         let (q, t) = (&m.state.q, m.state.t);
-        let mut beams: Vec<BeamExtent> = Vec::new();
         match &m.system {
             Mechanics::Planar(sys, _) => {
                 for (g, grp) in sys.beams.iter().enumerate() {
                     let z0 = sys.body_coords(grp.bodies.start, q);
                     let (tip, _) = sys.beam_tip(g, q);
                     let chord = (tip - nalgebra::Vector2::new(z0[0], z0[1])).norm();
-                    let frames = grp
-                        .bodies
-                        .clone()
-                        .filter_map(|body| {
-                            let b = sys.beam(body)?;
-                            let defl = b.largest_transverse(sys.body_coords(body, q));
-                            Some((b.name.clone(), b.length, defl))
-                        })
-                        .collect();
-                    beams.push((grp.name.clone(), grp.length, chord, frames));
+                    let frames = grp.bodies.clone().filter_map(|body| {
+                        let b = sys.beam(body)?;
+                        let defl = b.largest_transverse(sys.body_coords(body, q));
+                        Some((b.name.as_str(), b.length, defl))
+                    });
+                    let beam = (grp.name.as_str(), grp.length, chord);
+                    check_beam(beam, frames, t, &mut warned[g], messages)?;
                 }
             }
             Mechanics::Spatial(sys, index) => {
-                for (grp, &(root, tip)) in sys.beams.iter().zip(&index.beam_frames) {
+                for (g, (grp, &(root, tip))) in sys.beams.iter().zip(&index.beam_frames).enumerate()
+                {
                     let chord = (sys.frame_pose(tip, q).0 - sys.frame_pose(root, q).0).norm();
-                    let frames = grp
-                        .bodies
-                        .clone()
-                        .filter_map(|body| {
-                            let crate::multibody3d::Body3::Beam(b) = &sys.bodies[body] else {
-                                return None;
-                            };
-                            let z = sys.body_coords(body, q);
-                            let defl = b.largest_transverse(z.rows(7, b.nflex()));
-                            Some((b.name.clone(), b.length, defl))
-                        })
-                        .collect();
-                    beams.push((grp.name.clone(), grp.length, chord, frames));
-                }
-            }
-        }
-        for (g, (beam, length, chord, frames)) in beams.into_iter().enumerate() {
-            // a beam does not stretch: a chord longer than the beam is a model out of range
-            if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * length {
-                return Err(EngineError::Stretched {
-                    beam,
-                    t,
-                    chord,
-                    length,
-                });
-            }
-            // each floating frame's own deformation must stay small against its length
-            for (frame, length, defl) in frames {
-                if defl > length || !defl.is_finite() {
-                    return Err(EngineError::Runaway {
-                        beam: frame,
-                        t,
-                        deflection: defl,
-                        length,
+                    let frames = grp.bodies.clone().filter_map(|body| {
+                        let crate::multibody3d::Body3::Beam(b) = &sys.bodies[body] else {
+                            return None;
+                        };
+                        let z = sys.body_coords(body, q);
+                        let defl = b.largest_transverse(z.rows(7, b.nflex()));
+                        Some((b.name.as_str(), b.length, defl))
                     });
-                }
-                if defl > 0.05 * length && !self.warned[g] {
-                    self.warned[g] = true;
-                    self.messages.push(format!(
-                        "beam '{beam}': deflection {defl:.3e} m of frame '{frame}' at t = {t} s \
-                         is {:.1} % of the frame's length, beyond the small-deformation range of \
-                         a floating frame; use (more) substructures (or geometric_stiffening for \
-                         a spinning beam)",
-                        100.0 * defl / length
-                    ));
+                    let beam = (grp.name.as_str(), grp.length, chord);
+                    check_beam(beam, frames, t, &mut warned[g], messages)?;
                 }
             }
         }
@@ -684,6 +648,50 @@ fn law_mut(s: &mut Scene, joint: usize) -> &mut crate::scene::LawSpec {
         .as_mut()
         .expect("drive parameters exist only for drives")
         .law
+}
+
+/// The validity rules of one beam (name, length, chord from root to tip) and its floating
+/// frames (name, length, largest transverse deflection) at time t: a chord longer than the
+/// beam is a model out of range (`Stretched`), a frame bent past its length has run away
+/// (`Runaway`), past 5 % it is warned about once per beam (`warned`).
+fn check_beam<'a>(
+    (beam, length, chord): (&str, f64, f64),
+    frames: impl Iterator<Item = (&'a str, f64, f64)>,
+    t: f64,
+    warned: &mut bool,
+    messages: &mut Vec<String>,
+) -> Result<(), EngineError> {
+    // a beam does not stretch: a chord longer than the beam is a model out of range
+    if !chord.is_finite() || chord > (1.0 + STRETCH_LIMIT) * length {
+        return Err(EngineError::Stretched {
+            beam: beam.to_string(),
+            t,
+            chord,
+            length,
+        });
+    }
+    // each floating frame's own deformation must stay small against its length
+    for (frame, length, defl) in frames {
+        if defl > length || !defl.is_finite() {
+            return Err(EngineError::Runaway {
+                beam: frame.to_string(),
+                t,
+                deflection: defl,
+                length,
+            });
+        }
+        if defl > 0.05 * length && !*warned {
+            *warned = true;
+            messages.push(format!(
+                "beam '{beam}': deflection {defl:.3e} m of frame '{frame}' at t = {t} s is \
+                 {:.1} % of the frame's length, beyond the small-deformation range of a \
+                 floating frame; use (more) substructures (or geometric_stiffening for a \
+                 spinning beam)",
+                100.0 * defl / length
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A 3D output of a planar model (a 3D scene reduced to the plane): nothing leaves the plane.
