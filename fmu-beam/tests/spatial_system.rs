@@ -257,18 +257,8 @@ fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
         }
         None => {
             let beam = fmu_beam::beam::spatial_beam::SpatialBeam::new("beam", &props);
-            let u = &beam.undeformed;
-            let m = beam.mass;
-            let c = u.c0 / m;
-            let jc = u.i0 - (Matrix3::identity() * c.dot(&c) - c * c.transpose()) * m;
             let b = sys.add_rigid(
-                RigidBody3 {
-                    name: "beam".into(),
-                    mass: m,
-                    com: c,
-                    inertia: jc,
-                    frames: vec![("a".into(), Vector3::zeros(), axes)],
-                },
+                RigidBody3::of_beam(&beam, vec![("a".into(), Vector3::zeros(), axes)]),
                 Vector3::zeros(),
                 Matrix3::identity(),
             );

@@ -107,24 +107,14 @@ fn props(b: &BeamSpec, elements: usize, damping: bool) -> SpatialBeamProps {
 /// A rigid bar with the mass and inertia of the undeformed beam, frames `a` and `b`.
 fn rigid_bar(b: &BeamSpec) -> RigidBody3 {
     let beam = SpatialBeam::new(&b.name, &props(b, 1, false));
-    let u = &beam.undeformed;
-    let m = beam.mass;
-    let c = u.c0 / m;
-    let jc = u.i0 - (Matrix3::identity() * c.dot(&c) - c * c.transpose()) * m;
-    RigidBody3 {
-        name: b.name.clone(),
-        mass: m,
-        com: c,
-        inertia: jc,
-        frames: vec![
+    let tip = Vector3::new(b.length, 0.0, 0.0);
+    RigidBody3::of_beam(
+        &beam,
+        vec![
             ("a".into(), Vector3::zeros(), Matrix3::identity()),
-            (
-                "b".into(),
-                Vector3::new(b.length, 0.0, 0.0),
-                Matrix3::identity(),
-            ),
+            ("b".into(), tip, Matrix3::identity()),
         ],
-    }
+    )
 }
 
 /// The system of a validated 3D scene computing `effects`, and where its parts are.

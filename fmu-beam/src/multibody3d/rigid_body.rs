@@ -16,6 +16,24 @@ pub struct RigidBody3 {
 }
 
 impl RigidBody3 {
+    /// The rigid equivalent of a beam: its mass, centre of mass and inertia about the centre
+    /// of mass in the undeformed configuration, with the named frames `frames`.
+    pub fn of_beam(
+        beam: &crate::beam::spatial_beam::SpatialBeam,
+        frames: Vec<(String, Vector3<f64>, Matrix3<f64>)>,
+    ) -> RigidBody3 {
+        let u = &beam.undeformed;
+        let m = beam.mass;
+        let c = u.c0 / m;
+        RigidBody3 {
+            name: beam.name.clone(),
+            mass: m,
+            com: c,
+            inertia: u.i0 - (Matrix3::identity() * c.dot(&c) - c * c.transpose()) * m,
+            frames,
+        }
+    }
+
     /// Static moment m c and inertia about the body origin J_o = J_c + m (cᵀc I − c cᵀ).
     fn origin_inertia(&self) -> (Vector3<f64>, Matrix3<f64>) {
         let c = self.com;

@@ -281,18 +281,8 @@ fn add_model(
     match model {
         Model::Rigid => {
             let beam = SpatialBeam::new("beam", &props(length, 1, InertiaModel::Full, 0.0));
-            let u = &beam.undeformed;
-            let m = beam.mass;
-            let c = u.c0 / m;
-            let jc = u.i0 - (Matrix3::identity() * c.dot(&c) - c * c.transpose()) * m;
             let b = sys.add_rigid(
-                RigidBody3 {
-                    name: "beam".into(),
-                    mass: m,
-                    com: c,
-                    inertia: jc,
-                    frames: vec![("a".into(), Vector3::zeros(), root)],
-                },
+                RigidBody3::of_beam(&beam, vec![("a".into(), Vector3::zeros(), root)]),
                 Vector3::zeros(),
                 Matrix3::identity(),
             );
