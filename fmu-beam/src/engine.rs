@@ -4,7 +4,7 @@
 
 use crate::effects::Effects;
 use crate::error::EngineError;
-use crate::integrator::{self, GaState, Settings, Stats, Stepper};
+use crate::integrator::{self, GaState, Memory, Settings, SplitReason, Stats, Stepper};
 use crate::mechanics::Mechanics;
 use crate::multibody::equations::Equations;
 use crate::multibody::law::InputValue;
@@ -18,7 +18,17 @@ use crate::variables::{
 #[derive(Debug, Clone)]
 struct Model {
     system: Mechanics,
+    /// The state at the current communication point.
     state: GaState,
+    /// The integrator's own state, at the end of its last step; a unit without inputs steps
+    /// across communication points, so it may lie past `state`.
+    front: GaState,
+    /// The state at the start of the integrator's last step, when that step ends past the
+    /// communication point: `state` is interpolated between it and `front`.
+    back: Option<GaState>,
+    /// Whether the unit has inputs: then every step lands on the communication points, where
+    /// the master may change them.
+    lands: bool,
     stats: Stats,
     stepper: Stepper,
     /// Input values and derivatives (3 per input) of the last step: when the master changes
@@ -29,6 +39,17 @@ struct Model {
     body_index: Vec<usize>,
 }
 
+/// The integration state of a built model, as get/set FMU state copy it.
+#[derive(Debug, Clone, PartialEq)]
+struct ModelState {
+    state: GaState,
+    front: GaState,
+    back: Option<GaState>,
+    stats: Stats,
+    applied_inputs: Vec<f64>,
+    memory: Memory,
+}
+
 /// Everything that changes while an instance runs; get/set FMU state copy exactly this.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Snapshot {
@@ -36,7 +57,7 @@ pub struct Snapshot {
     start_time: f64,
     values: Vec<f64>,
     input_ders: Vec<[f64; 2]>,
-    state: Option<(GaState, Stats, Vec<f64>)>,
+    model: Option<ModelState>,
 }
 
 #[derive(Debug, Clone)]
@@ -52,6 +73,8 @@ pub struct Engine {
     input_ders: Vec<[f64; 2]>,
     /// Beams already warned about leaving the small-deformation range.
     warned: Vec<bool>,
+    /// Reasons for cutting a fixed step already logged.
+    split_reported: Vec<SplitReason>,
     /// Log messages (warnings) for the master, taken by the FMI layer.
     messages: Vec<String>,
     initialized: bool,
@@ -62,7 +85,7 @@ pub struct Engine {
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 /// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
 const STRETCH_LIMIT: f64 = 0.01;
-const STATE_VERSION: u32 = 1;
+const STATE_VERSION: u32 = 2;
 
 impl Engine {
     pub fn new(scene: Scene) -> Engine {
@@ -76,6 +99,7 @@ impl Engine {
         Engine {
             input_ders: vec![[0.0; 2]; values.len()],
             warned: vec![false; scene.beams.len()],
+            split_reported: Vec::new(),
             messages: Vec::new(),
             scene,
             effects,
@@ -195,13 +219,16 @@ impl Engine {
         }
         let applied = flat_inputs(&m.system);
         if applied != m.applied_inputs {
-            let st = &mut m.state;
+            // a unit with inputs lands on every communication point: its front is the state
+            let st = &mut m.front;
             let after = st.t * (1.0 + 1e-13) + 1e-13;
             let (qdd, lambda) =
                 integrator::initial::consistent_accelerations(&m.system, &st.q, &st.v, after)?;
             st.acc = qdd.clone();
             st.qdd = qdd;
             st.lambda = lambda;
+            m.state.clone_from(st);
+            m.state.t = t0;
             m.applied_inputs = applied;
         }
         Ok(())
@@ -266,7 +293,7 @@ impl Engine {
         }
         self.values[i] = value;
         match &mut self.model {
-            Some(m) if self.initialized => m.stepper.settings = Settings::from_scene(&scene),
+            Some(m) if self.initialized => m.stepper.set_settings(Settings::from_scene(&scene)),
             _ => self.model = None,
         }
         Ok(())
@@ -372,7 +399,10 @@ impl Engine {
             self.model = Some(Model {
                 applied_inputs: flat_inputs(&system),
                 stepper: Stepper::new(&system, settings),
+                lands: !system.inputs().is_empty(),
                 system,
+                front: state.clone(),
+                back: None,
                 state,
                 stats: Stats::default(),
                 joint_index,
@@ -427,19 +457,37 @@ impl Engine {
         self.built()?;
         self.sync_inputs(now)?;
         let m = self.model.as_mut().expect("built above");
-        let saved = (m.state.clone(), m.stats);
-        let mut result = m
-            .stepper
-            .step_to(&m.system, &mut m.state, &mut m.stats, now + h);
+        let saved = m.save();
+        let mut result = m.advance(now + h);
         if result.is_ok() {
             result = self.monitor_validity();
         }
+        if result.is_ok() {
+            self.report_split(saved.stats.split);
+        }
         if result.is_err() {
-            let m = self.model.as_mut().expect("built above");
-            m.state = saved.0;
-            m.stats = saved.1;
+            self.model.as_mut().expect("built above").put_back(saved);
         }
         result
+    }
+
+    /// Logs the first fixed step of each kind that was cut short (`solver.split_steps` counts
+    /// them all), given the count before the communication step.
+    fn report_split(&mut self, before: u64) {
+        let m = self.model.as_ref().expect("model built");
+        let Some((t, h, why)) = m.stepper.last_split else {
+            return;
+        };
+        if m.stats.split == before || self.split_reported.contains(&why) {
+            return;
+        }
+        self.split_reported.push(why);
+        self.messages.push(format!(
+            "fixed step of {:.6e} s cut to {h:.6e} s at t = {t} s {}; solver.split_steps counts \
+             every such step (this message is given once per reason)",
+            m.stepper.settings.max_step,
+            why.describe()
+        ));
     }
 
     /// The validity monitor: a floating frame assumes small deformation. Beyond 5 % of its
@@ -496,10 +544,7 @@ impl Engine {
             start_time: self.start_time,
             values: self.values.clone(),
             input_ders: self.input_ders.clone(),
-            state: self
-                .model
-                .as_ref()
-                .map(|m| (m.state.clone(), m.stats, m.applied_inputs.clone())),
+            model: self.model.as_ref().map(Model::save),
         }
     }
 
@@ -509,21 +554,27 @@ impl Engine {
         self.start_time = s.start_time;
         self.model = None;
         self.initialized = false;
-        if let Some((state, stats, applied)) = &s.state {
+        if let Some(saved) = &s.model {
             let m = self.built()?;
-            if state.q.len() != m.state.q.len() || state.lambda.len() != m.state.lambda.len() {
+            let (n, k) = (m.state.q.len(), m.state.lambda.len());
+            let fits = |st: &GaState| st.q.len() == n && st.lambda.len() == k;
+            let ahead_fits = fits(&saved.front) && saved.back.as_ref().is_none_or(fits);
+            let point_fits = saved
+                .memory
+                .point
+                .as_ref()
+                .is_none_or(|p| p.q.len() == n && p.lambda.len() == k);
+            if !fits(&saved.state) || !ahead_fits || !point_fits {
                 return Err(EngineError::BadState {
                     message: "the state does not belong to this model".into(),
                 });
             }
-            if applied.len() != m.applied_inputs.len() {
+            if saved.applied_inputs.len() != m.applied_inputs.len() {
                 return Err(EngineError::BadState {
                     message: "the state has another number of inputs".into(),
                 });
             }
-            m.state = state.clone();
-            m.stats = *stats;
-            m.applied_inputs = applied.clone();
+            m.put_back(saved.clone());
         }
         self.initialized = s.initialized;
         Ok(())
@@ -548,13 +599,22 @@ impl Engine {
         put_vec(&mut w, &s.values);
         let ders: Vec<f64> = s.input_ders.iter().flatten().copied().collect();
         put_vec(&mut w, &ders);
-        match &s.state {
+        match &s.model {
             None => w.push(0),
-            Some((st, stats, applied)) => {
+            Some(ms) => {
                 w.push(1);
-                st.write(&mut w);
-                stats.write(&mut w);
-                put_vec(&mut w, applied);
+                ms.state.write(&mut w);
+                ms.front.write(&mut w);
+                match &ms.back {
+                    None => w.push(0),
+                    Some(b) => {
+                        w.push(1);
+                        b.write(&mut w);
+                    }
+                }
+                ms.stats.write(&mut w);
+                put_vec(&mut w, &ms.applied_inputs);
+                ms.memory.write(&mut w);
             }
         }
         w
@@ -591,9 +651,25 @@ impl Engine {
             return Err(bad("wrong number of input derivatives"));
         }
         let input_ders = ders.chunks(2).map(|c| [c[0], c[1]]).collect();
-        let state = match r.u8()? {
+        let model = match r.u8()? {
             0 => None,
-            1 => Some((GaState::read(&mut r)?, Stats::read(&mut r)?, r.vec()?)),
+            1 => {
+                let state = GaState::read(&mut r)?;
+                let front = GaState::read(&mut r)?;
+                let back = match r.u8()? {
+                    0 => None,
+                    1 => Some(GaState::read(&mut r)?),
+                    _ => return Err(bad("corrupt flag")),
+                };
+                Some(ModelState {
+                    state,
+                    front,
+                    back,
+                    stats: Stats::read(&mut r)?,
+                    applied_inputs: r.vec()?,
+                    memory: Memory::read(&mut r)?,
+                })
+            }
             _ => return Err(bad("corrupt flag")),
         };
         if r.pos != bytes.len() {
@@ -607,8 +683,57 @@ impl Engine {
             start_time,
             values,
             input_ders,
-            state,
+            model,
         })
+    }
+}
+
+impl Model {
+    fn save(&self) -> ModelState {
+        ModelState {
+            state: self.state.clone(),
+            front: self.front.clone(),
+            back: self.back.clone(),
+            stats: self.stats,
+            applied_inputs: self.applied_inputs.clone(),
+            memory: self.stepper.memory().clone(),
+        }
+    }
+
+    fn put_back(&mut self, s: ModelState) {
+        self.state = s.state;
+        self.front = s.front;
+        self.back = s.back;
+        self.stats = s.stats;
+        self.applied_inputs = s.applied_inputs;
+        self.stepper.restore_memory(s.memory);
+    }
+
+    /// Advances the state at the communication point to `t_end`: the integrator goes on from
+    /// its front until it reaches `t_end` (a unit with inputs lands every step on it), and the
+    /// state at `t_end` is the front where it ends there, else interpolated inside the last step.
+    fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
+        // within this of t_end, the integrator's state counts as at t_end
+        let snap = 1e-6 * self.stepper.settings.max_step.min(t_end - self.state.t);
+        if self.front.t < t_end - snap {
+            self.back = self.stepper.advance(
+                &self.system,
+                &mut self.front,
+                &mut self.stats,
+                t_end,
+                self.lands,
+            )?;
+        }
+        match &self.back {
+            Some(back) if self.front.t - t_end > snap => {
+                self.state.interpolate_into(back, &self.front, t_end)
+            }
+            _ => {
+                self.state.clone_from(&self.front);
+                self.state.t = t_end;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -758,9 +883,12 @@ fn common_output(m: &Model, kind: OutputKind) -> f64 {
         K::SolverNewtonIterations => m.stats.newton_iterations as f64,
         K::SolverJacobians => m.stats.jacobians as f64,
         K::SolverRejectedSteps => m.stats.rejected as f64,
+        K::SolverSplitSteps => m.stats.split as f64,
+        // of the integrator's own state (an interpolated state between two steps carries the
+        // interpolation's error too)
         K::ConstraintResidual => {
             let mut g = nalgebra::DVector::zeros(m.system.m());
-            m.system.constraints(&st.q, st.t, &mut g);
+            m.system.constraints(&m.front.q, m.front.t, &mut g);
             g.amax()
         }
         // no other output is offered by a scene whose system lacks it

@@ -143,6 +143,7 @@ pub enum OutputKind {
     SolverNewtonIterations,
     SolverJacobians,
     SolverRejectedSteps,
+    SolverSplitSteps,
     /// Largest |g_k(q, t)| over the joint equations (m or rad): the constraint drift.
     ConstraintResidual,
 }
@@ -644,7 +645,7 @@ impl VariableTable {
             "solver.constraint_residual".into(),
             VarType::Real,
             None,
-            "Largest residual of the joint equations |g(q, t)| (m or rad): the constraint drift",
+            "Largest residual of the joint equations |g(q, t)| (m or rad) at the end of the last internal step: the constraint drift",
             K::ConstraintResidual,
         );
         for (name, kind, desc) in [
@@ -667,6 +668,13 @@ impl VariableTable {
                 "solver.rejected_steps",
                 K::SolverRejectedSteps,
                 "Rejected internal steps since initialization",
+            ),
+            (
+                "solver.split_steps",
+                K::SolverSplitSteps,
+                "Fixed steps cut shorter than solver.max_step since initialization (to land on a \
+                 drive law's jump or on a communication point of a unit with inputs, or after a \
+                 failed Newton iteration); 0 with error control",
             ),
         ] {
             t.output(name.into(), VarType::Integer, None, desc, kind);

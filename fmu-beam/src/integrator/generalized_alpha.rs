@@ -9,13 +9,14 @@
 //! - M. Géradin, A. Cardona (2001), Flexible Multibody Dynamics, §11 (error estimate
 //!   h²(β - 1/6)(a_{n+1} - a_n)).
 
+use super::newton::{Contraction, Verdict, KAPPA};
 use super::{Settings, Stats};
 use crate::error::EngineError;
 use crate::multibody::{CoordinateKind, Equations};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 
 /// The integration state at a step boundary.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct GaState {
     pub t: f64,
     /// Proposed size of the next internal step (adaptive mode).
@@ -29,6 +30,33 @@ pub struct GaState {
     pub lambda: DVector<f64>,
     /// Work done by drives and loads since the start (J), trapezoidal in time.
     pub work: f64,
+}
+
+impl Clone for GaState {
+    fn clone(&self) -> GaState {
+        GaState {
+            t: self.t,
+            h: self.h,
+            q: self.q.clone(),
+            v: self.v.clone(),
+            acc: self.acc.clone(),
+            qdd: self.qdd.clone(),
+            lambda: self.lambda.clone(),
+            work: self.work,
+        }
+    }
+
+    /// Copies into the vectors already there (no allocation per communication step).
+    fn clone_from(&mut self, o: &GaState) {
+        self.t = o.t;
+        self.h = o.h;
+        self.q.clone_from(&o.q);
+        self.v.clone_from(&o.v);
+        self.acc.clone_from(&o.acc);
+        self.qdd.clone_from(&o.qdd);
+        self.lambda.clone_from(&o.lambda);
+        self.work = o.work;
+    }
 }
 
 /// Coefficients of the scheme for a spectral radius at infinity ρ∞.
@@ -55,12 +83,14 @@ impl Coefficients {
     }
 }
 
-const MAX_NEWTON: usize = 8;
+const MAX_NEWTON: usize = 16;
+/// Refactorizations of the iteration matrix at the current iterate within one step.
+const MAX_REFRESH: usize = 2;
 /// Absolute part of the error weights, as a fraction of the system's length (or of 1 rad):
 /// a coordinate's local error must stay below tol × (|q_i| + ERROR_SCALE × scale_i).
 const ERROR_SCALE: f64 = 1.0;
-/// Newton stops when its correction is this fraction of the tolerance.
-const NEWTON_KAPPA: f64 = 0.01;
+/// A Newton correction this many machine epsilons of the coordinates' size is rounding.
+const ROUNDING: f64 = 1e3 * f64::EPSILON;
 /// Largest growth of the step size from one step to the next.
 const MAX_GROWTH: f64 = 5.0;
 /// A proposed growth of the step size up to this factor keeps the step size, and with it the
@@ -69,6 +99,14 @@ const KEEP_STEP: f64 = 1.2;
 /// Step sizes within this relative difference share an iteration matrix (equal substeps of a
 /// fixed-step run differ by rounding).
 const SAME_STEP: f64 = 1e-9;
+/// Newton's error per step relative to the step's increment, in units of the tolerance.
+const INCREMENT_SHARE: f64 = 0.001;
+/// A fixed step this much shorter than `max_step` (relative) is a split step.
+const SPLIT: f64 = 1e-6;
+/// A step that ends this close (relative) to a point it must land on lands on it.
+const LAND: f64 = 1e-6;
+/// A remainder this short (relative to the step) before a landing point takes no implicit step.
+const TINY: f64 = 1e-6;
 
 /// The factor on the step size after an accepted step whose controller proposes `grow`.
 fn step_factor(grow: f64) -> f64 {
@@ -80,8 +118,53 @@ fn step_factor(grow: f64) -> f64 {
     }
 }
 
+/// Where the factorized iteration matrix was evaluated. The factors are not stored: a restored
+/// state factorizes the matrix again at this point, so that it continues bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatrixPoint {
+    pub q: DVector<f64>,
+    pub v: DVector<f64>,
+    pub qdd: DVector<f64>,
+    pub lambda: DVector<f64>,
+    pub t: f64,
+    pub h: f64,
+}
+
+/// What the integrator carries from one step to the next beyond the state itself (part of the
+/// FMU state): the iteration matrix's point and its measured contraction.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Memory {
+    pub point: Option<MatrixPoint>,
+    pub contraction: Contraction,
+    /// The grid of a fixed-step run: its anchor and the steps taken from it.
+    pub grid: Option<(f64, u64)>,
+}
+
+/// Why a fixed step was cut short.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SplitReason {
+    /// To land on the end of the communication step (a unit with inputs).
+    Landing,
+    /// To land on a jump of a drive law.
+    Breakpoint,
+    /// Newton did not converge at the full step.
+    Newton,
+}
+
+impl SplitReason {
+    pub fn describe(self) -> &'static str {
+        match self {
+            SplitReason::Landing => {
+                "to land on the communication point (the unit's inputs may change there)"
+            }
+            SplitReason::Breakpoint => "to land on a jump of a drive law",
+            SplitReason::Newton => "because Newton's iteration did not converge at the full step",
+        }
+    }
+}
+
 /// The integrator with its workspace. The factorized iteration matrix is reused across
-/// Newton iterations and internal steps of one communication step, while it converges well.
+/// Newton iterations, internal steps and communication steps while it converges well.
 #[derive(Debug, Clone)]
 pub struct Stepper {
     pub settings: Settings,
@@ -90,7 +173,9 @@ pub struct Stepper {
     /// Coordinates of massless bodies.
     algebraic: Vec<usize>,
     lu: Option<LU<f64, Dyn, Dyn>>,
-    lu_h: f64,
+    memory: Memory,
+    /// The last fixed step cut short: time, size and why (the engine logs it).
+    pub last_split: Option<(f64, f64, SplitReason)>,
     // workspace
     mm: DMatrix<f64>,
     kt: DMatrix<f64>,
@@ -134,7 +219,8 @@ impl Stepper {
             scale,
             algebraic,
             lu: None,
-            lu_h: 0.0,
+            memory: Memory::default(),
+            last_split: None,
             mm: DMatrix::zeros(n, n),
             kt: DMatrix::zeros(n, n),
             ct: DMatrix::zeros(n, n),
@@ -144,6 +230,39 @@ impl Stepper {
             g: DVector::zeros(m),
             rhs: DVector::zeros(n + m),
         }
+    }
+
+    /// What the next step inherits besides the state (for the FMU state).
+    pub fn memory(&self) -> &Memory {
+        &self.memory
+    }
+
+    /// Puts back a saved memory: the iteration matrix is factorized again at its point when
+    /// the next step needs it.
+    pub fn restore_memory(&mut self, memory: Memory) {
+        self.lu = None;
+        self.memory = memory;
+    }
+
+    /// New settings (a tunable solver parameter changed): the iteration matrix is dropped.
+    pub fn set_settings(&mut self, settings: Settings) {
+        if settings != self.settings {
+            self.settings = settings;
+            self.forget_all();
+        }
+    }
+
+    /// Drops the iteration matrix (and, as the settings may have changed, the fixed grid).
+    fn forget_all(&mut self) {
+        self.forget();
+        self.memory.grid = None;
+    }
+
+    /// Drops the iteration matrix.
+    fn forget(&mut self) {
+        self.lu = None;
+        self.memory.point = None;
+        self.memory.contraction.fresh();
     }
 
     /// Weighted RMS norm of a position-like vector against the tolerance.
@@ -169,9 +288,26 @@ impl Stepper {
         stats: &mut Stats,
         t_end: f64,
     ) -> Result<(), EngineError> {
-        // The factorization is not part of the FMU state: start each communication step afresh
-        // so that a restored state continues bit for bit.
-        self.lu = None;
+        self.advance(sys, st, stats, t_end, true).map(|_| ())
+    }
+
+    /// Integrates `st` until it reaches `t_end`. With `land` the last step ends exactly on
+    /// `t_end`; without, the steps go on as the error control (or the fixed step) has them, and
+    /// the last may end past `t_end`: then the state before it is returned, for the caller to
+    /// interpolate at `t_end`. Steps always land on the jumps of drive laws.
+    ///
+    /// Fixed steps lie on a grid, anchor + k·`max_step` (the anchor is the start, or the last
+    /// point a step had to land on), so that their times do not drift with rounding. A fixed
+    /// step that has to be cut short (to land, or to get Newton to converge) is counted in
+    /// `Stats::split` and its reason kept in `last_split`.
+    pub fn advance<S: Equations + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut GaState,
+        stats: &mut Stats,
+        t_end: f64,
+        land: bool,
+    ) -> Result<Option<GaState>, EngineError> {
         let set = self.settings;
         let h_min = 1e-12 * t_end.abs().max(1.0);
         let mut h_try = if set.adaptive {
@@ -179,33 +315,65 @@ impl Stepper {
         } else {
             set.max_step
         };
+        // a fixed step whose Newton iteration failed is covered in smaller steps up to here
+        let mut divided_until: Option<f64> = None;
         let breakpoints = sys.breakpoints();
-        while st.t < t_end {
-            // land on the end of the communication step, or on a jump of a drive law before it
-            let target = breakpoints
+        let mut back = None;
+        let reached = |t: f64| {
+            if land {
+                t >= t_end
+            } else {
+                t >= t_end - TINY * set.max_step
+            }
+        };
+        while !reached(st.t) {
+            // the next time a step must end on: a jump of a drive law, the end of the
+            // communication step when landing, the end of a divided fixed step
+            let bp = breakpoints
                 .iter()
                 .copied()
-                .find(|&b| b > st.t * (1.0 + 1e-14) + 1e-14 && b <= t_end)
-                .unwrap_or(t_end);
+                .find(|&b| b > st.t + TINY * set.max_step)
+                .unwrap_or(f64::INFINITY);
+            let mut target = bp;
+            if land {
+                target = target.min(t_end);
+            }
+            if let Some(d) = divided_until {
+                target = target.min(d);
+            }
             let remaining = target - st.t;
-            // a leftover of rounding (the sum of substeps falls short by an ulp) is no step
-            if remaining <= 1e-12 * target.abs().max(1.0) {
+            let nominal = if set.adaptive {
+                h_try.min(set.max_step)
+            } else if divided_until.is_some() {
+                h_try
+            } else {
+                // the next point of the grid
+                let (anchor, k) = self.memory.grid.unwrap_or((st.t, 0));
+                anchor + (k + 1) as f64 * set.max_step - st.t
+            };
+            // a leftover of rounding, or a sliver before a point to land on, is no implicit
+            // step: an explicit Taylor step of that length is exact to its order
+            if remaining <= TINY * nominal {
+                taylor(st, remaining);
                 st.t = target;
+                self.landed(st.t);
+                if target == bp {
+                    restart(sys, st)?;
+                }
+                if divided_until.is_some_and(|d| d <= st.t) {
+                    divided_until = None;
+                    h_try = set.max_step;
+                }
                 continue;
             }
-            let mut h = h_try.min(set.max_step);
-            if !set.adaptive {
-                // equal substeps that land on t_end
-                let k = (remaining / set.max_step * (1.0 - 1e-9)).ceil().max(1.0);
-                h = h.min(remaining / k);
-            } else if h >= remaining {
+            let mut h = nominal;
+            // the last step lands; the one before shares what is left with it when a sliver
+            // would remain
+            let last = h >= remaining * (1.0 - LAND);
+            if last {
                 h = remaining;
             } else if h > 0.5 * remaining {
                 h = 0.5 * remaining;
-            }
-            let last = h >= remaining * (1.0 - 1e-9);
-            if last {
-                h = remaining;
             }
             let t_new = if last { target } else { st.t + h };
             if t_new <= st.t {
@@ -227,12 +395,36 @@ impl Stepper {
                         // that stops at t_n acts no more in (t_n, t_n+1])
                         let p0 = sys.power(&st.q, &st.v, &st.lambda, st.t + 1e-9 * h);
                         let p1 = sys.power(&new.q, &new.v, &new.lambda, t_new);
-                        *st = new;
-                        st.work += 0.5 * h * (p0 + p1);
+                        let old = std::mem::replace(st, new);
+                        st.work = old.work + 0.5 * h * (p0 + p1);
                         st.t = t_new;
+                        back = Some(old);
                         stats.steps += 1;
-                        if last && breakpoints.contains(&target) {
+                        if !set.adaptive {
+                            if h < set.max_step * (1.0 - SPLIT) {
+                                stats.split += 1;
+                                let why = if divided_until.is_some() {
+                                    SplitReason::Newton
+                                } else if target == bp {
+                                    SplitReason::Breakpoint
+                                } else {
+                                    SplitReason::Landing
+                                };
+                                self.last_split = Some((st.t, h, why));
+                            }
+                            match self.memory.grid {
+                                Some((anchor, k)) if h == nominal && divided_until.is_none() => {
+                                    self.memory.grid = Some((anchor, k + 1))
+                                }
+                                _ => self.landed(t_new),
+                            }
+                        }
+                        if last && target == bp {
                             restart(sys, st)?;
+                        }
+                        if last && divided_until == Some(target) {
+                            divided_until = None;
+                            h_try = set.max_step;
                         }
                         if set.adaptive {
                             let grow = if err > 0.0 {
@@ -284,6 +476,9 @@ impl Stepper {
                     }
                 }
             }
+            if !set.adaptive && divided_until.is_none() {
+                divided_until = Some(t_new);
+            }
             if h_try < h_min {
                 return Err(EngineError::StepTooSmall {
                     t: st.t,
@@ -293,10 +488,17 @@ impl Stepper {
                 });
             }
         }
-        Ok(())
+        Ok(back.filter(|_| st.t > t_end))
     }
 
-    /// Builds and factorizes the scaled iteration matrix at the current iterate.
+    /// A fixed-step run landed on `t` off its grid: the grid goes on from there.
+    fn landed(&mut self, t: f64) {
+        if !self.settings.adaptive {
+            self.memory.grid = Some((t, 0));
+        }
+    }
+
+    /// Builds and factorizes the scaled iteration matrix at a point.
     #[allow(clippy::too_many_arguments)]
     fn factorize<S: Equations + ?Sized>(
         &mut self,
@@ -308,7 +510,6 @@ impl Stepper {
         t: f64,
         h: f64,
         c: &Coefficients,
-        stats: &mut Stats,
     ) -> bool {
         let (n, m) = (sys.n(), sys.m());
         let d = c.beta * h * h;
@@ -329,14 +530,12 @@ impl Stepper {
             }
         }
         self.jac.view_mut((n, n), (m, m)).fill(0.0);
-        stats.jacobians += 1;
         let lu = self.jac.clone().lu();
         if !lu.is_invertible() {
             self.lu = None;
             return false;
         }
         self.lu = Some(lu);
-        self.lu_h = h;
         true
     }
 
@@ -354,8 +553,23 @@ impl Stepper {
         let d = c.beta * h * h;
         let beta_p = (1.0 - c.alpha_m) / (d * (1.0 - c.alpha_f));
         let gamma_p = c.gamma / (c.beta * h);
-        if self.lu.is_some() && (h - self.lu_h).abs() > SAME_STEP * h {
-            self.lu = None;
+        if self
+            .memory
+            .point
+            .as_ref()
+            .is_some_and(|p| (h - p.h).abs() > SAME_STEP * h)
+        {
+            self.forget();
+        }
+        // a restored state: the same factors, at the same point
+        if self.lu.is_none() {
+            if let Some(p) = self.memory.point.take() {
+                if !self.factorize(sys, &p.q, &p.v, &p.qdd, &p.lambda, p.t, p.h, &c) {
+                    self.forget();
+                    return Err(Failure::Singular);
+                }
+                self.memory.point = Some(p);
+            }
         }
         // predictor: q''_{n+1} = q''_n
         let mut qdd = st.qdd.clone();
@@ -367,12 +581,37 @@ impl Stepper {
         let mut fresh = false;
         let mut prev = f64::INFINITY;
         let mut norm = f64::INFINITY;
+        let mut iterations = 0;
+        // corrections since the matrix was factorized, and refactorizations within this step
+        let (mut k, mut refreshed) = (0, 0);
+        let floor = ROUNDING / self.settings.tolerance;
+        // Newton's error bound: κ of the tolerance, and at most the tolerance's share of the
+        // step's own increment, so that it cannot pile up over many small steps (summed over a
+        // run it stays below tol × the path the coordinates travel)
+        let increment = self.norm((&q - &st.q).iter(), &q);
+        let kappa = KAPPA.min(INCREMENT_SHARE * self.settings.tolerance * increment);
         for it in 0..MAX_NEWTON {
             if self.lu.is_none() {
-                if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c, stats) {
+                if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c) {
+                    self.forget();
                     return Err(Failure::Singular);
                 }
+                stats.jacobians += 1;
+                self.memory = Memory {
+                    point: Some(MatrixPoint {
+                        q: q.clone(),
+                        v: v.clone(),
+                        qdd: qdd.clone(),
+                        lambda: lambda.clone(),
+                        t: t_new,
+                        h,
+                    }),
+                    contraction: Contraction::default(),
+                    grid: self.memory.grid,
+                };
                 fresh = true;
+                k = 0;
+                prev = f64::INFINITY;
             }
             sys.body_residual(&q, &v, &qdd, t_new, &mut self.r);
             sys.constraints_and_jacobian(&q, t_new, &mut self.g, &mut self.gm);
@@ -388,6 +627,7 @@ impl Stepper {
                 return Err(Failure::Singular);
             }
             stats.newton_iterations += 1;
+            iterations += 1;
             let dq = self.rhs.rows(0, n);
             q += dq;
             v.axpy(gamma_p, &dq, 1.0);
@@ -396,54 +636,78 @@ impl Stepper {
                 lambda[k] += self.rhs[n + k] / d;
             }
             if !dq.iter().all(|x| x.is_finite()) || !q.iter().all(|x| x.is_finite()) {
-                self.lu = None;
+                self.forget();
                 return Err(Failure::NonFinite);
             }
             norm = self.norm(dq.iter(), &q);
-            let rate = norm / prev;
-            let converged = norm <= NEWTON_KAPPA
-                || (it > 0 && rate < 1.0 && norm * rate / (1.0 - rate) <= NEWTON_KAPPA);
-            if converged {
-                let mut acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m
-                    + &qdd * (1.0 - c.alpha_f))
-                    / (1.0 - c.alpha_m);
-                // coordinates of massless bodies are algebraic: their accelerations enter no
-                // equation, and the scheme's recurrence would let them grow without bound
-                for &k in &self.algebraic {
-                    acc[k] = 0.0;
-                    qdd[k] = 0.0;
+            let verdict = self.memory.contraction.judge(
+                k,
+                norm,
+                prev,
+                floor,
+                MAX_NEWTON - 1 - it,
+                kappa,
+                fresh,
+            );
+            k += 1;
+            match verdict {
+                Verdict::Converged => {
+                    let mut acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m
+                        + &qdd * (1.0 - c.alpha_f))
+                        / (1.0 - c.alpha_m);
+                    // coordinates of massless bodies are algebraic: their accelerations enter
+                    // no equation, and the scheme's recurrence would let them grow without bound
+                    for &k in &self.algebraic {
+                        acc[k] = 0.0;
+                        qdd[k] = 0.0;
+                    }
+                    let err = (c.beta - 1.0 / 6.0).abs() * h * h;
+                    let err = self.norm(((&acc - &st.acc) * err).iter(), &q);
+                    if self.memory.contraction.slow() {
+                        self.forget(); // slow: a new matrix for the next step
+                    }
+                    return Ok((
+                        GaState {
+                            t: st.t,
+                            h: st.h,
+                            q,
+                            v,
+                            acc,
+                            qdd,
+                            lambda,
+                            work: st.work,
+                        },
+                        err,
+                    ));
                 }
-                let err = (c.beta - 1.0 / 6.0).abs() * h * h;
-                let err = self.norm(((&acc - &st.acc) * err).iter(), &q);
-                if rate > 0.5 && it > 0 {
-                    self.lu = None; // slow: refresh for the next step
+                Verdict::Continue => {
+                    prev = norm;
+                    // a matrix that contracts slowly (it was evaluated at a predictor far from
+                    // the solution, or steps ago) is evaluated again at the current iterate,
+                    // close to the solution: Newton's own quadratic convergence
+                    if self.memory.contraction.stalls() && k > 2 && refreshed < MAX_REFRESH {
+                        self.lu = None;
+                        refreshed += 1;
+                    }
                 }
-                return Ok((
-                    GaState {
-                        t: st.t,
-                        h: st.h,
-                        q,
-                        v,
-                        acc,
-                        qdd,
-                        lambda,
-                        work: st.work,
-                    },
-                    err,
-                ));
+                Verdict::Diverging => break,
             }
-            if it > 0 && rate >= 1.0 {
-                break;
-            }
-            prev = norm;
         }
-        self.lu = None;
+        self.forget();
         Err(Failure::Newton {
-            iterations: MAX_NEWTON,
+            iterations,
             correction: norm,
             fresh,
         })
     }
+}
+
+/// An explicit Taylor step of a length far below the step size (a remainder before a point to
+/// land on): q += h v + h²/2 q'', v += h q''; accelerations and multipliers kept.
+fn taylor(st: &mut GaState, h: f64) {
+    st.q.axpy(h, &st.v, 1.0);
+    st.q.axpy(0.5 * h * h, &st.qdd, 1.0);
+    st.v.axpy(h, &st.qdd, 1.0);
 }
 
 /// Restarts the scheme at a jump of a drive law: the accelerations and multipliers become those

@@ -1,9 +1,11 @@
 //! Time integration of M(q) q'' + G(q)ᵀλ = Q(q, q', t), g(q) = 0.
 
+pub mod dense_output;
 pub mod generalized_alpha;
 pub mod initial;
+pub mod newton;
 
-pub use generalized_alpha::{GaState, Stepper};
+pub use generalized_alpha::{GaState, MatrixPoint, Memory, SplitReason, Stepper};
 pub use initial::initial_state;
 
 use crate::engine::{write_vec, Reader};
@@ -37,6 +39,8 @@ pub struct Stats {
     pub newton_iterations: u64,
     pub jacobians: u64,
     pub rejected: u64,
+    /// Fixed steps cut short (to land, or after a failed Newton iteration).
+    pub split: u64,
 }
 
 impl Stats {
@@ -46,6 +50,7 @@ impl Stats {
             self.newton_iterations,
             self.jacobians,
             self.rejected,
+            self.split,
         ] {
             w.extend_from_slice(&x.to_le_bytes());
         }
@@ -57,6 +62,7 @@ impl Stats {
             newton_iterations: r.u64()?,
             jacobians: r.u64()?,
             rejected: r.u64()?,
+            split: r.u64()?,
         })
     }
 }
@@ -108,6 +114,103 @@ impl GaState {
             qdd,
             lambda,
             work,
+        })
+    }
+}
+
+impl Memory {
+    pub(crate) fn write(&self, w: &mut Vec<u8>) {
+        match &self.point {
+            None => w.push(0),
+            Some(p) => {
+                w.push(1);
+                w.extend_from_slice(&p.t.to_le_bytes());
+                w.extend_from_slice(&p.h.to_le_bytes());
+                for v in [&p.q, &p.v, &p.qdd, &p.lambda] {
+                    write_vec(w, v.as_slice());
+                }
+            }
+        }
+        match self.contraction.theta {
+            None => w.push(0),
+            Some(theta) => {
+                w.push(1);
+                w.extend_from_slice(&theta.to_le_bytes());
+            }
+        }
+        w.extend_from_slice(&self.contraction.since.to_le_bytes());
+        match self.grid {
+            None => w.push(0),
+            Some((anchor, k)) => {
+                w.push(1);
+                w.extend_from_slice(&anchor.to_le_bytes());
+                w.extend_from_slice(&k.to_le_bytes());
+            }
+        }
+    }
+
+    pub(crate) fn read(r: &mut Reader) -> Result<Memory, EngineError> {
+        let bad = |m: &str| EngineError::BadState {
+            message: format!("integrator memory: {m}"),
+        };
+        let flag = |r: &mut Reader| match r.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(bad("corrupt flag")),
+        };
+        let point = if flag(r)? {
+            let (t, h) = (r.f64()?, r.f64()?);
+            let mut vs = Vec::with_capacity(4);
+            for _ in 0..4 {
+                vs.push(nalgebra::DVector::from_vec(r.vec()?));
+            }
+            let n = vs[0].len();
+            if vs[1].len() != n || vs[2].len() != n {
+                return Err(bad("vectors of different lengths"));
+            }
+            if !(t.is_finite() && h.is_finite() && h > 0.0)
+                || vs.iter().any(|v| v.iter().any(|x| !x.is_finite()))
+            {
+                return Err(bad("non-finite or non-positive numbers"));
+            }
+            let lambda = vs.pop().unwrap_or_default();
+            let qdd = vs.pop().unwrap_or_default();
+            let v = vs.pop().unwrap_or_default();
+            let q = vs.pop().unwrap_or_default();
+            Some(MatrixPoint {
+                q,
+                v,
+                qdd,
+                lambda,
+                t,
+                h,
+            })
+        } else {
+            None
+        };
+        let theta = if flag(r)? {
+            let theta = r.f64()?;
+            if !(0.0..1.0).contains(&theta) {
+                return Err(bad("contraction rate outside [0, 1)"));
+            }
+            Some(theta)
+        } else {
+            None
+        };
+        let since = r.u32()?;
+        let grid = if flag(r)? {
+            let anchor = r.f64()?;
+            if !anchor.is_finite() {
+                return Err(bad("non-finite grid anchor"));
+            }
+            Some((anchor, r.u64()?))
+        } else {
+            None
+        };
+        Ok(Memory {
+            point,
+            contraction: newton::Contraction::measured(theta, since),
+            grid,
         })
     }
 }
