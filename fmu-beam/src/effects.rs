@@ -44,6 +44,9 @@ pub const QUASI_STATIC_RATIO: f64 = 10.0;
 /// `auto`: spin above this fraction of the first bending frequency needs geometric stiffening
 /// (the first frequency then rises by more than ≈ 5 %).
 pub const SPIN_RATIO: f64 = 0.3;
+/// `auto`: an axial force above this share of the buckling load needs geometric stiffening (it
+/// changes the bending stiffness by about that share).
+pub const AXIAL_SHARE: f64 = 0.01;
 
 /// The resolved effects: what the system computes.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,6 +149,13 @@ pub fn first_bending_frequency(b: &BeamSpec) -> f64 {
         FrameKind::Pinned => PI,
     };
     beta_l * beta_l * (ej / (mu * b.length.powi(4))).sqrt()
+}
+
+/// Euler's buckling load (N) of a beam pinned at both ends, π²EI/L²: the scale its axial force
+/// is weighed against.
+pub fn buckling_load(b: &BeamSpec) -> f64 {
+    let sec = Section::from_spec(&b.section);
+    PI * PI * b.material.e * sec.second_moment / (b.length * b.length)
 }
 
 /// First axial natural frequency (rad/s) of a beam alone, fixed at one end:
@@ -439,8 +449,24 @@ fn auto(scene: &Scene) -> Resolution {
         .filter_map(|j| j.drive.as_ref().filter(|d| d.kind == DriveKind::Motion))
         .map(|d| law_max_rate(&d.law))
         .fold(0.0, f64::max);
+    // the axial force of each beam, from a rigid-body run (only where a beam could need it)
+    let axial = if scene
+        .beams
+        .iter()
+        .any(|b| !b.rigid && !b.geometric_stiffening)
+    {
+        crate::axial_load::rigid_run(scene)
+    } else {
+        Ok(vec![
+            crate::axial_load::AxialLoad {
+                force: 0.0,
+                at: 0.0
+            };
+            scene.beams.len()
+        ])
+    };
     let mut beams = Vec::new();
-    for b in &scene.beams {
+    for (i, b) in scene.beams.iter().enumerate() {
         let w1 = first_bending_frequency(b);
         let n = b.name.clone();
         let mut o = BeamOptions {
@@ -448,18 +474,37 @@ fn auto(scene: &Scene) -> Resolution {
             modes: b.modes,
             ..BeamOptions::default()
         };
-        // geometric stiffening: a single-frame beam spinning near its first frequency
-        if b.substructures.is_none() && !b.rigid && spin >= SPIN_RATIO * w1 {
+        // geometric stiffening: a beam (one frame or substructures) spinning near its first
+        // frequency, or carrying an axial force that is a measurable share of its buckling load
+        let buckling = buckling_load(b);
+        let axial_force = axial.as_ref().ok().map(|a| a[i]);
+        let reason = if b.rigid {
+            None
+        } else if spin >= SPIN_RATIO * w1 {
+            Some(format!(
+                "spin up to {spin:.3} rad/s is {:.2} x the first bending frequency {w1:.3} rad/s \
+                 (>= {SPIN_RATIO}): centrifugal stiffening matters",
+                spin / w1
+            ))
+        } else {
+            axial_force
+                .filter(|a| a.force >= AXIAL_SHARE * buckling)
+                .map(|a| {
+                    format!(
+                        "a rigid-body run of the experiment puts an axial force of {:.3e} N on \
+                         the beam (at t = {:.3} s), {:.1} % of its buckling load π²EI/L² = \
+                         {buckling:.3e} N (>= {:.0} %): the geometric stiffness changes its \
+                         bending stiffness by about as much",
+                        a.force,
+                        a.at,
+                        100.0 * a.force / buckling,
+                        100.0 * AXIAL_SHARE
+                    )
+                })
+        };
+        if let Some(reason) = reason {
             o.geometric_stiffening = true;
-            why.push((
-                "geometric_stiffening",
-                n.clone(),
-                format!(
-                    "spin up to {spin:.3} rad/s is {:.2} x the first bending frequency \
-                     {w1:.3} rad/s (>= {SPIN_RATIO}): centrifugal stiffening matters",
-                    spin / w1
-                ),
-            ));
+            why.push(("geometric_stiffening", n.clone(), reason));
         } else if o.geometric_stiffening {
             why.push((
                 "geometric_stiffening",
@@ -467,17 +512,25 @@ fn auto(scene: &Scene) -> Resolution {
                 "asked for by the beam".into(),
             ));
         } else {
+            let load = match (&axial, axial_force) {
+                (_, Some(a)) => format!(
+                    "; the largest axial force of a rigid-body run, {:.3e} N, is {:.2} % of its \
+                     buckling load {buckling:.3e} N",
+                    a.force,
+                    100.0 * a.force / buckling
+                ),
+                (Err(e), _) => {
+                    format!("; its axial force is not known (the rigid-body run failed: {e})")
+                }
+                _ => String::new(),
+            };
             why.push((
                 "geometric_stiffening",
                 n.clone(),
-                if b.substructures.is_some() {
-                    "substructures carry the large rotations (planar paper §3.4)".into()
-                } else {
-                    format!(
-                        "spin {spin:.3} rad/s is below {SPIN_RATIO} x the first bending \
-                         frequency {w1:.3} rad/s"
-                    )
-                },
+                format!(
+                    "spin {spin:.3} rad/s is below {SPIN_RATIO} x the first bending frequency \
+                     {w1:.3} rad/s{load}"
+                ),
             ));
         }
         // axial deformation: where the stiffening needs the axial strain, or where the

@@ -4,6 +4,7 @@
 //! Data flow: [`scene::Scene`] (TOML) → [`multibody::System`] → [`integrator::Stepper`] →
 //! [`engine::Engine`] (one FMU instance, safe) → `fmi2` (the C ABI, the only unsafe code).
 
+pub mod axial_load;
 pub mod beam;
 pub mod effects;
 pub mod engine;

@@ -553,7 +553,7 @@ impl System {
     }
 
     /// Force and torque of load `l` at time t.
-    fn load_value(&self, l: &Load, t: f64) -> (Vector2<f64>, f64) {
+    pub fn load_value(&self, l: &Load, t: f64) -> (Vector2<f64>, f64) {
         if let Some(s) = &l.scale {
             let k = s.eval(t, &self.inputs).0;
             return (l.force * k, l.torque * k);
@@ -774,6 +774,14 @@ impl System {
     }
 
     /// Index of the scene joint `name` in `joints`.
+    /// The body a frame lies on (`None` for the world).
+    pub fn frame_body(&self, frame: usize) -> Option<usize> {
+        match &self.frames[frame] {
+            Frame::OnBody { body, .. } => Some(*body),
+            Frame::World { .. } => None,
+        }
+    }
+
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
     }
