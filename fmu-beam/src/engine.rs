@@ -21,8 +21,9 @@ struct Model {
     state: GaState,
     stats: Stats,
     stepper: Stepper,
-    /// Input values and derivatives (3 per input) of the last step: when the master changes
-    /// them, the scheme restarts from accelerations consistent with the new inputs.
+    /// Input values and derivatives (3 per input) at the current point as the last step ended
+    /// them (`interface::inputs_ended`): when the inputs set for the next step jump from them,
+    /// the scheme restarts from accelerations consistent with the new inputs.
     applied_inputs: Vec<f64>,
     /// System joint index of each scene joint, system body index of each scene body.
     joint_index: Vec<usize>,
@@ -57,6 +58,8 @@ pub struct Engine {
     initialized: bool,
     start_time: f64,
     model: Option<Model>,
+    /// Accelerations consistent with the inputs set now, and their derivatives.
+    feedthrough: crate::interface::Feedthrough,
 }
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
@@ -84,6 +87,7 @@ impl Engine {
             initialized: false,
             start_time: 0.0,
             model: None,
+            feedthrough: Default::default(),
         }
     }
 
@@ -194,7 +198,7 @@ impl Engine {
             }
         }
         let applied = flat_inputs(&m.system);
-        if applied != m.applied_inputs {
+        if crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system) {
             let st = &mut m.state;
             let after = st.t * (1.0 + 1e-13) + 1e-13;
             let (qdd, lambda) =
@@ -202,8 +206,8 @@ impl Engine {
             st.acc = qdd.clone();
             st.qdd = qdd;
             st.lambda = lambda;
-            m.applied_inputs = applied;
         }
+        m.applied_inputs = applied;
         Ok(())
     }
 
@@ -276,11 +280,41 @@ impl Engine {
         let i = self.lookup(vr, ty)?;
         match self.table.variables[i].binding {
             Binding::Parameter(_) | Binding::Input(_) => Ok(self.values[i]),
+            Binding::Output(OutputKind::LoadFrame(load, what)) => {
+                self.built()?;
+                let m = self.model.as_mut().expect("built above");
+                let (sys, st) = (&mut m.system, &m.state);
+                (self.feedthrough).frame_output(sys, st, &self.scene, load, what)
+            }
             Binding::Output(kind) => {
                 let m = self.built()?;
                 Ok(output(m, kind))
             }
         }
+    }
+
+    /// fmi2GetDirectionalDerivative: Σ_j ∂y_i/∂u_j dv_j for outputs y_i and inputs u_j, exact, at
+    /// the current communication point ([`crate::interface`]).
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv: &[f64],
+    ) -> Result<Vec<f64>, EngineError> {
+        crate::interface::check_references(&self.table, unknowns, knowns)?;
+        self.built()?;
+        let m = self.model.as_mut().expect("built above");
+        let (sys, st) = (&mut m.system, &m.state);
+        self.feedthrough.directional_derivative(
+            sys,
+            st,
+            &self.scene,
+            &self.table,
+            &m.joint_index,
+            unknowns,
+            knowns,
+            dv,
+        )
     }
 
     /// The scene with the given parameter values applied.
@@ -434,10 +468,12 @@ impl Engine {
         if result.is_ok() {
             result = self.monitor_validity();
         }
+        let m = self.model.as_mut().expect("built above");
         if result.is_err() {
-            let m = self.model.as_mut().expect("built above");
             m.state = saved.0;
             m.stats = saved.1;
+        } else {
+            m.applied_inputs = crate::interface::inputs_ended(&m.system, m.state.t);
         }
         result
     }
@@ -763,6 +799,7 @@ fn common_output(m: &Model, kind: OutputKind) -> f64 {
             m.system.constraints(&st.q, st.t, &mut g);
             g.amax()
         }
+        K::NextEventTime => crate::interface::next_event_time(&m.system, st.t),
         // no other output is offered by a scene whose system lacks it
         _ => f64::NAN,
     }
