@@ -324,6 +324,9 @@ pub fn check_references(
     Ok(())
 }
 
+/// The state and inputs that consistent accelerations belong to: (t, q, q', inputs).
+type AccelKey = (f64, DVector<f64>, DVector<f64>, Vec<InputValue>);
+
 /// The consistent accelerations at the current state and inputs, with the factorized matrix
 /// [[M, Gᵀ], [G, 0]] kept for the derivatives; recomputed when the state or inputs change.
 #[derive(Debug, Clone, Default)]
@@ -332,7 +335,7 @@ pub struct Feedthrough {
     matrix_at: Option<(f64, DVector<f64>)>,
     lu: Option<LU<f64, Dyn, Dyn>>,
     /// (t, q, q', inputs) of `qdd`.
-    accel_at: Option<(f64, DVector<f64>, DVector<f64>, Vec<InputValue>)>,
+    accel_at: Option<AccelKey>,
     qdd: DVector<f64>,
 }
 

@@ -215,7 +215,9 @@ fn the_frame_acceleration_is_the_rate_of_the_frame_velocity() {
         ("tip.wy", "tip.alphay"),
         ("tip.wz", "tip.alphaz"),
     ];
-    let cases: Vec<(Scene, Vec<(&str, &str)>, f64)> = vec![
+    // (scene, (velocity, acceleration) pairs, the short step)
+    type Case<'a> = (Scene, Vec<(&'a str, &'a str)>, f64);
+    let cases: Vec<Case> = vec![
         (
             scene("hinged_blade_hub.toml"),
             vec![

@@ -25,6 +25,9 @@ const EPS_FORWARD: f64 = 1e-7;
 /// Step of the second directional difference of g along q' (times max |q'|).
 const EPS_BIAS: f64 = 1e-3;
 
+/// One column of a frame's Jacobian: (coordinate, ∂x/∂q_k, ∂θ/∂q_k).
+pub type FrameColumn = (usize, Vector3<f64>, Vector3<f64>);
+
 /// A world force and torque on a frame, scaled by an optional time law (1 without one).
 #[derive(Debug, Clone)]
 pub struct Load3 {
@@ -435,11 +438,7 @@ impl System3 {
     /// Pose of frame `f` and, per coordinate k it depends on, (∂x/∂q_k, ∂θ/∂q_k): the world
     /// translation and rotation (axial part of ∂A_f A_fᵀ) per unit change of q_k, closed form
     /// ([`Frame3::pose_derivatives`]). Velocity J q', acceleration J q'' + bias.
-    pub fn frame_jacobian(
-        &self,
-        f: usize,
-        q: &DVector<f64>,
-    ) -> (Pose, Vec<(usize, Vector3<f64>, Vector3<f64>)>) {
+    pub fn frame_jacobian(&self, f: usize, q: &DVector<f64>) -> (Pose, Vec<FrameColumn>) {
         let mut d = Vec::new();
         let pose = self.frame_pose_derivatives(f, q, &mut d);
         let a = pose.1;
