@@ -361,8 +361,7 @@ impl Joints {
             self.set_forces(units, &self.lambda, Some((&slope, h)))?;
             self.stats.iterations += 1;
             if let Some(refused) = step(units)? {
-                self.jacobian = Some((jac, h));
-                return Ok(Some(refused));
+                return Ok(Some(self.refused(refused)));
             }
             for ((&(unit, _), c0), c1) in self
                 .counters
@@ -371,12 +370,11 @@ impl Joints {
                 .zip(self.step_counts(units)?)
             {
                 if c1 != c0 + 1 {
-                    self.jacobian = Some((jac, h));
                     self.stats.refusals += 1;
-                    return Ok(Some(Refused::Substeps {
+                    return Ok(Some(self.refused(Refused::Substeps {
                         unit: units[unit].name.clone(),
                         steps: c1 - c0,
-                    }));
+                    })));
                 }
             }
             let r = self.residual(units, |s| &s.position)?;
@@ -415,13 +413,19 @@ impl Joints {
             last = Some((end.clone(), r));
             end -= delta;
         }
-        // not converged: the next try (half the step) starts from the mobilities again
-        self.jacobian = None;
         self.stats.refusals += 1;
-        Ok(Some(Refused::Joints {
+        Ok(Some(self.refused(Refused::Joints {
             iterations: self.max_iterations,
             mismatch,
             tolerance: self.tolerance,
-        }))
+        })))
+    }
+
+    /// A refused step is retried (with half the step) from what is certain: the Jacobian of
+    /// the mobilities and the force held from the step's start.
+    fn refused(&mut self, why: Refused) -> Refused {
+        self.jacobian = None;
+        self.previous = None;
+        why
     }
 }
