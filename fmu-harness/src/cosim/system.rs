@@ -550,6 +550,46 @@ check = [{ variable = "a.e", max = 1.0 }]
     }
 
     #[test]
+    fn joints_are_read_and_checked() {
+        let joint = "[[joint]]\nname = \"pin\"\ntype = \"revolute\"\nframes = [\"a.p\", \"b.p\"]\n";
+        let s = parse(&format!("{OK}{joint}[coupling]\ntolerance = 1e-8\n")).unwrap();
+        assert_eq!(s.joints[0].kind, JointKind::Revolute);
+        assert_eq!(s.joints[0].frames, ["a.p".to_string(), "b.p".to_string()]);
+        assert_eq!(s.coupling.tolerance, 1e-8);
+        assert_eq!(s.coupling.max_iterations, 10);
+        let cases = [
+            (
+                joint.replace("b.p", "a.q"),
+                "field `joint[0].frames`: must name frames of two different units",
+            ),
+            (
+                joint.replace("b.p", "c.p"),
+                "field `joint[0].frames[1]`: = \"c.p\": no unit named `c`",
+            ),
+            (
+                joint.replace("revolute", "hinge"),
+                "unknown variant `hinge`",
+            ),
+            (
+                format!("{joint}[coupling]\nmax_iterations = 0\n"),
+                "field `coupling.max_iterations`",
+            ),
+        ];
+        for (extra, expected) in cases {
+            let e = parse(&format!("{OK}{extra}")).unwrap_err().to_string();
+            assert!(e.contains(expected), "expected `{expected}` in: {e}");
+        }
+        let variable = OK.replace(
+            "size = 1e-2 }",
+            "size = 1e-2, variable = { min = 1e-3, max = 1e-1, tolerance = 1e-3 } }",
+        );
+        let e = parse(&format!("{variable}{joint}"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("field `step.variable`"), "{e}");
+    }
+
+    #[test]
     fn errors_name_the_file_and_the_field() {
         let cases = [
             (

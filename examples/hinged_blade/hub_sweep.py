@@ -3,9 +3,9 @@ joined by `fmu-harness cosim` [[joint]], against the monolithic unit (scenes/hin
 the hub's inertia swept (`hub.rho`) from 0.01x to 100x, beside explicit Gauss-Seidel
 (the blade in motion causality, hinged_blade_arm_driven.toml, its hinge position interpolated,
 the reaction held), and the communication step swept at the scene's own inertia. Writes
-build/hinged_blade/study.{md,png} (and the plot into examples/hinged_blade/ with --readme).
+build/hinged_blade/hub_sweep.{md,png} (and the plot into examples/hinged_blade/ with --readme).
 
-    python study.py [--readme]
+    python hub_sweep.py [--readme]
 """
 
 import argparse
@@ -147,7 +147,7 @@ def main():
         it, us, _ = per_step(text)
         lines.append(f"| {step * 1e3:g} ms | {e[0]:.2e} | {e[1]:.2e} | {it:.2f} | {us:.2f} |")
         print(lines[-1], flush=True)
-    (OUT / "study.md").write_text("\n".join(lines) + "\n")
+    (OUT / "hub_sweep.md").write_text("\n".join(lines) + "\n")
 
     import matplotlib
     matplotlib.use("Agg")
@@ -167,10 +167,10 @@ def main():
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(OUT / "study.png", dpi=110)
+    fig.savefig(OUT / "hub_sweep.png", dpi=110)
     if a.readme:
-        fig.savefig(Path(__file__).parent / "study.png", dpi=110)
-    print((OUT / "study.md").read_text())
+        fig.savefig(Path(__file__).parent / "hub_sweep.png", dpi=110)
+    print((OUT / "hub_sweep.md").read_text())
 
 
 if __name__ == "__main__":
