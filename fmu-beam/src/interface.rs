@@ -15,9 +15,11 @@
 //! fmi2SetRealInputDerivatives only shape them inside the next step), the motion inputs'
 //! derivatives as the prescribed rates (a motion drive's bias uses its second derivative).
 //!
-//! Exact except: in 3D the velocity-dependent part of a frame's angular acceleration is a
-//! central difference along q' (relative error about 1e-8; the FMU's documentation says so).
-//! Its translation bias is exact: the position is a polynomial of degree 3 in q, whose central
+//! The derivatives involve no finite differences. The values do in one place each in 3D: the
+//! velocity-dependent part of a frame's angular acceleration is a central difference along q'
+//! (relative error about 1e-8 of that part), and the joints' acceleration bias is the 3D
+//! system's own second difference; the FMU's documentation says so ([`explain`]). A frame's
+//! translation bias is exact: the position is a polynomial of degree 3 in q, whose central
 //! second difference along q' is exact.
 //!
 //! # References
@@ -275,6 +277,67 @@ fn motion_slots(sys: &Mechanics) -> Vec<bool> {
         }
     }
     motion
+}
+
+/// What the unit's FMU documentation says about its direct feedthrough and derivatives.
+pub fn explain(scene: &Scene, table: &VariableTable) -> String {
+    let mut t = String::from(
+        "fmi2GetDirectionalDerivative gives exact partial derivatives of outputs with respect to \
+         inputs at the current communication point (providesDirectionalDerivative = true): with the \
+         state (q, q') fixed, the force inputs enter the accelerations linearly through \
+         [[M, G^T], [G, 0]] [q''; lambda] = [Q; -bias], which the unit factorizes and solves with \
+         each input's generalized force on the right: the derivatives involve no finite \
+         differences. Unknowns must be Real outputs and knowns Real inputs; any other reference is \
+         refused with fmi2Error and a message naming it.\n\n",
+    );
+    let feeds: Vec<String> = table
+        .variables
+        .iter()
+        .filter(|v| !v.dependencies.is_empty())
+        .map(|v| {
+            let deps: Vec<&str> = v
+                .dependencies
+                .iter()
+                .filter_map(|&d| table.get(d).map(|x| x.name.as_str()))
+                .collect();
+            format!("  {} <- {}", v.name, deps.join(", "))
+        })
+        .collect();
+    if feeds.is_empty() {
+        t.push_str("No output depends directly on an input (ModelStructure: dependencies=\"\").\n");
+    } else {
+        t.push_str(
+            "Outputs that depend directly on inputs (ModelStructure lists exactly these; every \
+             other output is a function of the state alone):\n",
+        );
+        t.push_str(&feeds.join("\n"));
+        t.push('\n');
+    }
+    if scene.loads.iter().any(|l| l.input) {
+        t.push_str(
+            "\nThe frame of each input load offers its position, velocity and acceleration \
+             (<load>.x ... .ax ... .alpha): the accelerations are consistent with the inputs as \
+             set now (their values; a motion input's derivatives give its prescribed rate and \
+             acceleration), so d(<load>.ax)/d(<load>.fx) is the frame's mobility.",
+        );
+        if scene.is_3d() {
+            t.push_str(
+                " In 3D two velocity-dependent terms of the acceleration values are differences \
+                 along q': the joints' acceleration bias (second differences of the constraints, \
+                 the integrator's own) and the frame's angular-acceleration bias (a central \
+                 difference of its angular velocity, relative error about 1e-8 of that term); the \
+                 frame's translation bias is exact, and the derivatives involve no differences.",
+            );
+        }
+        t.push('\n');
+    }
+    t.push_str(
+        "\nsolver.next_event_time is the next time where a drive or load law jumps (the unit \
+         lands there and restarts its integrator); a master joining units mechanically lands \
+         there too. An input whose value jumps between steps restarts the integrator; one that \
+         only changes its derivatives (a ramp that continues the last one) does not.\n",
+    );
+    t
 }
 
 /// The first jump of a drive or load law after `t` (as `Stepper::step_to` finds the breakpoints
