@@ -436,11 +436,13 @@ impl Feedthrough {
             .ok_or(EngineError::FeedthroughSingular { t })
     }
 
-    /// q'' consistent with the state and the inputs as set now.
+    /// q'' consistent with the state and the inputs as set now, just after the current time
+    /// (at a jump of a law, the accelerations the unit continues with, as its restart there).
     fn accelerations(&mut self, sys: &mut Mechanics, st: &GaState) -> Result<(), EngineError> {
+        let te = just_after(st.t);
         // inputs hold their set values at the current point
         for u in sys.inputs_mut().iter_mut() {
-            u.t0 = st.t;
+            u.t0 = te;
         }
         let key_matches = matches!(&self.accel_at,
             Some((t, q, v, u)) if *t == st.t && *q == st.q && *v == st.v && u == sys.inputs());
@@ -450,9 +452,9 @@ impl Feedthrough {
         self.factorize(sys, st)?;
         let (n, m) = (sys.n(), sys.m());
         let mut r = DVector::zeros(n);
-        sys.body_residual(&st.q, &st.v, &DVector::zeros(n), st.t, &mut r);
+        sys.body_residual(&st.q, &st.v, &DVector::zeros(n), te, &mut r);
         let mut bias = DVector::zeros(m);
-        sys.accel_bias(&st.q, &st.v, st.t, &mut bias);
+        sys.accel_bias(&st.q, &st.v, te, &mut bias);
         let mut rhs = DVector::zeros(n + m);
         rhs.rows_mut(0, n).copy_from(&(-r));
         rhs.rows_mut(n, m).copy_from(&(-bias));
@@ -491,8 +493,9 @@ impl Feedthrough {
         knowns: &[u32],
         dv: &[f64],
     ) -> Result<Vec<f64>, EngineError> {
+        let te = just_after(st.t);
         for u in sys.inputs_mut().iter_mut() {
-            u.t0 = st.t;
+            u.t0 = te;
         }
         let slot = |vr: u32| match table.get(vr).map(|v| v.binding) {
             Some(Binding::Input(s)) => s,
@@ -511,7 +514,7 @@ impl Feedthrough {
             let mut rhs = DVector::zeros(n + m);
             for (&vr, &d) in knowns.iter().zip(dv) {
                 if d != 0.0 {
-                    for (k, x) in input_force(sys, st, slot(vr)) {
+                    for (k, x) in input_force(sys, st, te, slot(vr)) {
                         rhs[k] += x * d;
                     }
                 }
@@ -625,12 +628,18 @@ fn residual_derivative(
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// ∂Q/∂u of one input slot, as (coordinate, value) pairs.
-fn input_force(sys: &Mechanics, st: &GaState, slot: usize) -> Vec<(usize, f64)> {
+/// ∂Q/∂u of one input slot at time t, as (coordinate, value) pairs.
+fn input_force(sys: &Mechanics, st: &GaState, t: f64, slot: usize) -> Vec<(usize, f64)> {
     match sys {
-        Mechanics::Planar(s, _) => s.input_force(&st.q, &st.v, st.t, slot),
-        Mechanics::Spatial(s, _) => s.input_force(&st.q, st.t, slot),
+        Mechanics::Planar(s, _) => s.input_force(&st.q, &st.v, t, slot),
+        Mechanics::Spatial(s, _) => s.input_force(&st.q, t, slot),
     }
+}
+
+/// A time just after t, as the integrator restarts at a jump of a law
+/// (`generalized_alpha::restart`): a law that stops at t acts no more.
+fn just_after(t: f64) -> f64 {
+    t * (1.0 + 1e-13) + 1e-13
 }
 
 /// The system frame of scene load `load` (an input load: its frame is the load's).
