@@ -9,7 +9,9 @@ their interface forces, iterated at each step's end with the units' interface Ja
 - the same coupling written as an fmpy script (examples/split_slider_crank/joint_fmpy.py) gives
   the master's result;
 - the lag-hinge rotor with a hub 100 times lighter than the scene's couples, where explicit
-  Gauss-Seidel diverges."""
+  Gauss-Seidel diverges;
+- through fmpy, a unit's mobility equals the difference of its outputs, and a known that is not
+  an input is refused naming it."""
 
 import re
 import subprocess
@@ -98,3 +100,40 @@ def test_a_light_hub_couples_where_explicit_gauss_seidel_diverges():
     assert err[0] < 1e-2 * np.abs(mono[:, 0]).max() and err[1] < 1e-3
     explicit, failed, _ = blade_study.harness(blade_study.explicit_text(h, rho))
     assert explicit is None and failed < 0.1
+
+
+def test_directional_derivatives_of_a_unit_through_fmpy(fmu_dir):
+    """The mobility through fmpy equals the difference of the unit's outputs (set the force, read
+    the acceleration); a known that is not an input is refused with a message naming it."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi1 import FMICallException
+
+    from fmu_util import Instance
+
+    fmu = fmu_dir / "slider_crank_split_rod_force.fmu"
+    inst = Instance(extract(fmu), read_model_description(fmu), name="mobility")
+    try:
+        inst.initialize()
+        inst.step(20)
+        f = [inst.vr("pin.fx"), inst.vr("pin.fy")]
+        a = [inst.vr("pin.ax"), inst.vr("pin.ay")]
+        w = np.array([inst.fmu.getDirectionalDerivative(a, [k], [1.0]) for k in f]).T
+        diff = np.zeros((2, 2))
+        for j, k in enumerate(f):
+            inst.fmu.setReal([k], [0.5])
+            plus = np.array(inst.fmu.getReal(a))
+            inst.fmu.setReal([k], [-0.5])
+            diff[:, j] = plus - np.array(inst.fmu.getReal(a))
+            inst.fmu.setReal([k], [0.0])
+        print(f"mobility of the rod's pin (1/kg):\n{w}")
+        assert np.abs(w - diff).max() <= 1e-12 * np.abs(w).max()
+        try:
+            inst.fmu.getDirectionalDerivative(a, [inst.vr("pin.x")], [1.0])
+            raise AssertionError("a known that is an output was accepted")
+        except FMICallException:
+            pass
+        assert any("'pin.x'" in m and "input" in m for m in inst.logger.errors()), inst.logger.text()
+        # the refusal changed nothing
+        assert inst.fmu.getDirectionalDerivative(a, [f[0]], [1.0]) == list(w[:, 0])
+    finally:
+        inst.close()
