@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools release fmus demo test check bench example-split example-arm example-sweep clean distclean
+.PHONY: .venv tools release fmus demo test check bench example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -66,12 +66,22 @@ bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
 
-# The split slider-crank (examples/split_slider_crank): cosim, the fmpy script, the step study.
+# The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
+# script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).
 example-split: .venv fmus
 	mkdir -p build/split
 	$(HARNESS) cosim examples/split_slider_crank/system.toml -o build/split/cosim.csv
 	$(PY) examples/split_slider_crank/cosim_fmpy.py -o build/split/fmpy.csv
 	$(PY) examples/split_slider_crank/study.py
+	$(HARNESS) cosim examples/split_slider_crank/joint.toml -o build/split/joint.csv
+	$(PY) examples/split_slider_crank/joint_fmpy.py -o build/split/joint_fmpy.csv
+	$(PY) examples/split_slider_crank/joint_study.py
+
+# The lag-hinge rotor split at the hinge (examples/hinged_blade): the joint, the hub inertia swept.
+example-hinge: .venv fmus
+	mkdir -p build/hinged_blade
+	$(HARNESS) cosim examples/hinged_blade/system.toml -o build/hinged_blade/cosim.csv
+	$(PY) examples/hinged_blade/hub_sweep.py
 
 # The examples (examples/README.md): the flexible arm under PID control (fmpy script) and the
 # C4 parameter sweep on Dask (a local cluster of 2 workers; see examples/sweep.py --help).

@@ -31,8 +31,9 @@ struct Model {
     lands: bool,
     stats: Stats,
     stepper: Stepper,
-    /// Input values and derivatives (3 per input) of the last step: when the master changes
-    /// them, the scheme restarts from accelerations consistent with the new inputs.
+    /// Input values and derivatives (3 per input) at the current point as the last step ended
+    /// them (`interface::inputs_ended`): when the inputs set for the next step jump from them,
+    /// the scheme restarts from accelerations consistent with the new inputs.
     applied_inputs: Vec<f64>,
     /// System joint index of each scene joint, system body index of each scene body.
     joint_index: Vec<usize>,
@@ -80,6 +81,8 @@ pub struct Engine {
     initialized: bool,
     start_time: f64,
     model: Option<Model>,
+    /// Accelerations consistent with the inputs set now, and their derivatives.
+    feedthrough: crate::interface::Feedthrough,
 }
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
@@ -108,6 +111,7 @@ impl Engine {
             initialized: false,
             start_time: 0.0,
             model: None,
+            feedthrough: Default::default(),
         }
     }
 
@@ -218,7 +222,7 @@ impl Engine {
             }
         }
         let applied = flat_inputs(&m.system);
-        if applied != m.applied_inputs {
+        if crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system) {
             // a unit with inputs lands on every communication point: its front is the state
             let st = &mut m.front;
             let after = st.t * (1.0 + 1e-13) + 1e-13;
@@ -229,8 +233,8 @@ impl Engine {
             st.lambda = lambda;
             m.state.clone_from(st);
             m.state.t = t0;
-            m.applied_inputs = applied;
         }
+        m.applied_inputs = applied;
         Ok(())
     }
 
@@ -303,11 +307,41 @@ impl Engine {
         let i = self.lookup(vr, ty)?;
         match self.table.variables[i].binding {
             Binding::Parameter(_) | Binding::Input(_) => Ok(self.values[i]),
+            Binding::Output(OutputKind::LoadFrame(load, what)) => {
+                self.built()?;
+                let m = self.model.as_mut().expect("built above");
+                let (sys, st) = (&mut m.system, &m.state);
+                (self.feedthrough).frame_output(sys, st, &self.scene, load, what)
+            }
             Binding::Output(kind) => {
                 let m = self.built()?;
                 Ok(output(m, kind))
             }
         }
+    }
+
+    /// fmi2GetDirectionalDerivative: Σ_j ∂y_i/∂u_j dv_j for outputs y_i and inputs u_j, exact, at
+    /// the current communication point ([`crate::interface`]).
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv: &[f64],
+    ) -> Result<Vec<f64>, EngineError> {
+        crate::interface::check_references(&self.table, unknowns, knowns)?;
+        self.built()?;
+        let m = self.model.as_mut().expect("built above");
+        let (sys, st) = (&mut m.system, &m.state);
+        self.feedthrough.directional_derivative(
+            sys,
+            st,
+            &self.scene,
+            &self.table,
+            &m.joint_index,
+            unknowns,
+            knowns,
+            dv,
+        )
     }
 
     /// The scene with the given parameter values applied.
@@ -465,8 +499,11 @@ impl Engine {
         if result.is_ok() {
             self.report_split(saved.stats.split);
         }
+        let m = self.model.as_mut().expect("built above");
         if result.is_err() {
-            self.model.as_mut().expect("built above").put_back(saved);
+            m.put_back(saved);
+        } else {
+            m.applied_inputs = crate::interface::inputs_ended(&m.system, m.state.t);
         }
         result
     }
@@ -891,6 +928,7 @@ fn common_output(m: &Model, kind: OutputKind) -> f64 {
             m.system.constraints(&m.front.q, m.front.t, &mut g);
             g.amax()
         }
+        K::NextEventTime => crate::interface::next_event_time(&m.system, st.t),
         // no other output is offered by a scene whose system lacks it
         _ => f64::NAN,
     }

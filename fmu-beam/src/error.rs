@@ -84,6 +84,21 @@ pub enum EngineError {
     BadStep { message: String },
     #[error("FMU state: {message}")]
     BadState { message: String },
+    #[error(
+        "{role} value reference {vr}{}: {reason}",
+        .name.as_ref().map(|n| format!(" ('{n}')")).unwrap_or_default()
+    )]
+    DirectionalDerivative {
+        vr: u32,
+        role: &'static str,
+        name: Option<String>,
+        reason: String,
+    },
+    #[error(
+        "the accelerations at t = {t} s are not determined by the inputs: [[M, G^T], [G, 0]] is \
+         singular (a body without mass or inertia that the joints do not hold)"
+    )]
+    FeedthroughSingular { t: f64 },
 }
 
 impl EngineError {

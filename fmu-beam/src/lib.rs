@@ -11,6 +11,7 @@ pub mod engine;
 pub mod error;
 pub mod fmi2;
 pub mod integrator;
+pub mod interface;
 pub mod mechanics;
 pub mod modes;
 pub mod multibody;

@@ -146,6 +146,10 @@ pub enum OutputKind {
     SolverSplitSteps,
     /// Largest |g_k(q, t)| over the joint equations (m or rad): the constraint drift.
     ConstraintResidual,
+    /// A kinematic quantity of the frame of input load `usize` (scene load index).
+    LoadFrame(usize, crate::interface::FrameQuantity),
+    /// Time of the next jump of a drive or load law after the current time (f64::MAX if none).
+    NextEventTime,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -169,6 +173,9 @@ pub struct Variable {
     /// Start value of parameters (Booleans as 0/1).
     pub start: Option<f64>,
     pub binding: Binding,
+    /// Of an output: the inputs (value references) it depends on directly, for ModelStructure
+    /// ([`crate::interface::dependencies`]); empty otherwise.
+    pub dependencies: Vec<u32>,
 }
 
 /// A unit in SI base-unit exponents, for UnitDefinitions.
@@ -199,6 +206,7 @@ pub const UNITS: &[UnitDef] = &[
     unit("m/s", 0, 1, -1, 0),
     unit("rad/s", 0, 0, -1, 1),
     unit("m/s2", 0, 1, -2, 0),
+    unit("rad/s2", 0, 0, -2, 1),
     unit("kg/m3", 1, -3, 0, 0),
     unit("Pa", 1, -1, -2, 0),
     unit("m2", 0, 2, 0, 0),
@@ -679,6 +687,36 @@ impl VariableTable {
         ] {
             t.output(name.into(), VarType::Integer, None, desc, kind);
         }
+        t.push(
+            "solver.next_event_time".into(),
+            VarType::Real,
+            C::Output,
+            V::Discrete,
+            Some("s"),
+            "Time of the next jump of a drive or load law after the current time, where the unit \
+             lands and restarts (a master coupling units mechanically lands there too); \
+             1.7976931348623157e308 when none",
+            None,
+            O(K::NextEventTime),
+        );
+        // the frames of input loads: what a master joining this unit mechanically reads
+        for (i, l) in scene.loads.iter().enumerate().filter(|(_, l)| l.input) {
+            for (suffix, what, unit, desc) in
+                crate::interface::frame_outputs(if scene.is_3d() { 3 } else { 2 })
+            {
+                t.output(
+                    format!("{}.{suffix}", l.name),
+                    VarType::Real,
+                    Some(unit),
+                    desc,
+                    K::LoadFrame(i, what),
+                );
+            }
+        }
+        let deps = crate::interface::dependencies(scene, &t.vars);
+        for (v, d) in t.vars.iter_mut().zip(deps) {
+            v.dependencies = d;
+        }
         VariableTable { variables: t.vars }
     }
 
@@ -800,6 +838,7 @@ impl Builder {
             description: description.to_string(),
             start,
             binding,
+            dependencies: Vec::new(),
         });
     }
 

@@ -121,6 +121,15 @@ pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
     *const fmi2Integer,
     *const fmi2Real,
 ) -> fmi2Status;
+pub type fmi2GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+    *mut fmi2Real,
+) -> fmi2Status;
 pub type fmi2DoStepTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
 
@@ -269,6 +278,7 @@ pub struct Api {
     set_fmu_state: Option<fmi2SetFMUstateTYPE>,
     free_fmu_state: Option<fmi2FreeFMUstateTYPE>,
     set_real_input_derivatives: Option<fmi2SetRealInputDerivativesTYPE>,
+    get_directional_derivative: Option<fmi2GetDirectionalDerivativeTYPE>,
     // Last: the function pointers above are only valid while the library is loaded.
     _library: libloading::Library,
 }
@@ -329,6 +339,10 @@ impl Api {
             set_real_input_derivatives: optional!(
                 "fmi2SetRealInputDerivatives",
                 fmi2SetRealInputDerivativesTYPE
+            ),
+            get_directional_derivative: optional!(
+                "fmi2GetDirectionalDerivative",
+                fmi2GetDirectionalDerivativeTYPE
             ),
             _library: library,
         }))
@@ -545,6 +559,37 @@ impl Instance {
                 vr.len(),
                 order.as_ptr(),
                 values.as_ptr(),
+            )
+        }))
+    }
+
+    /// `fmi2GetDirectionalDerivative(vUnknown_ref, vKnown_ref, dvKnown, dvUnknown)`; panics if
+    /// the slices differ in length (a bug of the caller).
+    pub fn get_directional_derivative(
+        &mut self,
+        unknowns: &[fmi2ValueReference],
+        knowns: &[fmi2ValueReference],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<Status, Refusal> {
+        assert!(
+            knowns.len() == dv_known.len() && unknowns.len() == dv_unknown.len(),
+            "fmi2GetDirectionalDerivative: lengths differ"
+        );
+        let f = self
+            .api
+            .get_directional_derivative
+            .ok_or(Refusal::NotExported("fmi2GetDirectionalDerivative"))?;
+        // SAFETY: each array holds the number of elements passed with it.
+        Ok(Status::from_c(unsafe {
+            f(
+                self.component,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                dv_known.as_ptr(),
+                dv_unknown.as_mut_ptr(),
             )
         }))
     }

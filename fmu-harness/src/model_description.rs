@@ -163,17 +163,18 @@ pub fn model_variables(table: &VariableTable) -> Result<String, HarnessError> {
 
 /// Outputs and InitialUnknowns (outputs and calculated parameters).
 ///
-/// Without inputs an output depends on no input: `dependencies=""`, exact. With inputs the
-/// table does not say which outputs feed through directly (a reaction torque may, a position
-/// does not), so the attribute is left out, which the standard reads as "depends on all":
-/// conservative and honest. InitialUnknowns never carry it.
+/// Each output lists the inputs it depends on directly (`Variable::dependencies`, from
+/// `fmu_beam::interface::dependencies`): the accelerations of input loads' frames on the force
+/// inputs, an input effort drive's effort on its input, the constraint residual on the motion
+/// inputs; every other output on none (`dependencies=""`). InitialUnknowns never carry it.
 pub fn model_structure(table: &VariableTable) -> Result<String, HarnessError> {
     let vars = ordered(table);
-    let indices = |pred: &dyn Fn(&Variable) -> bool| -> Vec<String> {
+    let position = |vr: u32| vars.iter().position(|v| v.vr == vr).map(|i| i + 1);
+    let indices = |pred: &dyn Fn(&Variable) -> bool| -> Vec<usize> {
         vars.iter()
             .enumerate()
             .filter(|(_, v)| pred(v))
-            .map(|(i, _)| (i + 1).to_string())
+            .map(|(i, _)| i)
             .collect()
     };
     let outputs = indices(&|v| v.causality == Causality::Output);
@@ -181,24 +182,29 @@ pub fn model_structure(table: &VariableTable) -> Result<String, HarnessError> {
         (v.causality == Causality::Output && v.initial == Some(Initial::Calculated))
             || v.causality == Causality::CalculatedParameter
     });
-    let has_inputs = vars.iter().any(|v| v.causality == Causality::Input);
     let mut x = Xml::new();
     x.start("ModelStructure", &[])?;
     if !outputs.is_empty() {
         x.start("Outputs", &[])?;
-        for i in &outputs {
-            if has_inputs {
-                x.empty("Unknown", &[("index", i)])?;
-            } else {
-                x.empty("Unknown", &[("index", i), ("dependencies", "")])?;
-            }
+        for &i in &outputs {
+            let deps: Vec<String> = vars[i]
+                .dependencies
+                .iter()
+                .filter_map(|&vr| position(vr))
+                .map(|p| p.to_string())
+                .collect();
+            let index = (i + 1).to_string();
+            x.empty(
+                "Unknown",
+                &[("index", &index), ("dependencies", &deps.join(" "))],
+            )?;
         }
         x.end("Outputs")?;
     }
     if !initial_unknowns.is_empty() {
         x.start("InitialUnknowns", &[])?;
-        for i in &initial_unknowns {
-            x.empty("Unknown", &[("index", i)])?;
+        for &i in &initial_unknowns {
+            x.empty("Unknown", &[("index", &(i + 1).to_string())])?;
         }
         x.end("InitialUnknowns")?;
     }
@@ -285,8 +291,8 @@ mod tests {
     }
 
     #[test]
-    fn outputs_depend_on_no_input_only_when_there_is_none() {
-        let mut table = VariableTable::build(&small_scene());
+    fn each_output_lists_exactly_the_inputs_it_depends_on() {
+        let table = VariableTable::build(&small_scene());
         let outputs = table
             .variables
             .iter()
@@ -295,13 +301,34 @@ mod tests {
         let s = model_structure(&table).unwrap();
         assert_eq!(s.matches("dependencies=\"\"").count(), outputs, "{s}");
 
-        let v = &mut table.variables[0];
-        v.causality = Causality::Input;
-        v.variability = fmu_beam::variables::Variability::Continuous;
-        v.initial = None;
+        // an input load: the accelerations of its frame depend on its three inputs (1-based
+        // indices of the ordered variables), every other output on none
+        let text = "name = \"t\"\n[[beam]]\nname = \"b\"\nlength = 1.0\nelements = 2\n\
+                    material = { rho = 1.0, E = 1.0 }\nsection = { A = 1.0, J = 1.0 }\n\
+                    [[joint]]\nname = \"j\"\ntype = \"revolute\"\nframes = [\"world\", \"b.a\"]\n\
+                    [[load]]\nname = \"tip\"\nframe = \"b.b\"\ninput = true\n";
+        let table = VariableTable::build(&Scene::from_toml_str(text, "inline").unwrap());
+        let index = |name: &str| table.by_name(name).unwrap().vr + 1;
+        let deps = format!(
+            "{} {} {}",
+            index("tip.fx"),
+            index("tip.fy"),
+            index("tip.torque")
+        );
         let s = model_structure(&table).unwrap();
-        assert!(!s.contains("dependencies"), "{s}");
-        assert_eq!(s.matches("<Unknown index=").count(), 2 * outputs, "{s}");
+        for out in ["tip.ax", "tip.ay", "tip.alpha"] {
+            let line = format!(
+                "<Unknown index=\"{}\" dependencies=\"{deps}\"/>",
+                index(out)
+            );
+            assert!(s.contains(&line), "{line} in {s}");
+        }
+        let outputs = table
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+            .count();
+        assert_eq!(s.matches("dependencies=\"\"").count(), outputs - 3, "{s}");
     }
 
     #[test]

@@ -57,7 +57,8 @@ pub fn contents(scene: &Scene, binary: &[u8]) -> Result<FmuContents, HarnessErro
     })
 }
 
-/// documentation/index.html: the scene's description and its resolved effects.
+/// documentation/index.html: the scene's description, its resolved effects and its direct
+/// feedthrough (`fmu_beam::interface::explain`).
 fn documentation(scene: &Scene) -> String {
     let escape = |s: &str| {
         s.replace('&', "&amp;")
@@ -65,13 +66,17 @@ fn documentation(scene: &Scene) -> String {
             .replace('>', "&gt;")
     };
     let effects = fmu_beam::effects::resolve(scene).explain(scene);
+    let feedthrough =
+        fmu_beam::interface::explain(scene, &fmu_beam::variables::VariableTable::build(scene));
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head>\n\
          <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Effects</h2>\n<pre>\n{effects}</pre>\n\
+         <h2>Direct feedthrough and directional derivatives</h2>\n<pre>\n{feedthrough}</pre>\n\
          </body></html>\n",
         name = escape(&scene.name),
         description = escape(&scene.description),
         effects = escape(&effects),
+        feedthrough = escape(&feedthrough),
     )
 }
 

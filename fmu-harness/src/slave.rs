@@ -101,6 +101,7 @@ pub struct ModelDescription {
     pub guid: String,
     pub can_get_and_set_fmu_state: bool,
     pub can_interpolate_inputs: bool,
+    pub provides_directional_derivative: bool,
     pub variables: Vec<Variable>,
     pub default_experiment: DefaultExperiment,
 }
@@ -118,6 +119,7 @@ impl ModelDescription {
             guid: String::new(),
             can_get_and_set_fmu_state: false,
             can_interpolate_inputs: false,
+            provides_directional_derivative: false,
             variables: Vec::new(),
             default_experiment: DefaultExperiment::default(),
         };
@@ -158,6 +160,8 @@ impl ModelDescription {
                         attr("canGetAndSetFMUstate")?.as_deref() == Some("true");
                     md.can_interpolate_inputs =
                         attr("canInterpolateInputs")?.as_deref() == Some("true");
+                    md.provides_directional_derivative =
+                        attr("providesDirectionalDerivative")?.as_deref() == Some("true");
                 }
                 b"DefaultExperiment" => {
                     let num = |key: &str| -> Result<Option<f64>, SlaveError> {
@@ -513,6 +517,22 @@ impl Slave {
             .set_real_input_derivatives(vr, order, values)
             .map_err(|r| Self::refused(F, r))?;
         self.check(F, s)
+    }
+
+    /// `fmi2GetDirectionalDerivative`: Σ_j ∂unknown_i/∂known_j dv_j for each unknown.
+    pub fn get_directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+    ) -> Result<Vec<f64>, SlaveError> {
+        const F: &str = "fmi2GetDirectionalDerivative";
+        let mut out = vec![0.0; unknowns.len()];
+        let s = self
+            .live(F)?
+            .get_directional_derivative(unknowns, knowns, dv_known, &mut out)
+            .map_err(|r| Self::refused(F, r))?;
+        self.check(F, s).map(|_| out)
     }
 
     /// `fmi2GetFMUstate` into an empty state or one this instance made before.

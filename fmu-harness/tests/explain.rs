@@ -11,10 +11,15 @@ fn explain_prints_every_effect_with_its_reason() {
     let text = String::from_utf8_lossy(&r.stdout);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(text.contains("(effects = auto)"), "{text}");
-    // C4 under auto: a slow ramp far below the axial modes, no gravity, rotating substructures
+    // C4 under auto: no gravity, rotating substructures spun above their first bending
+    // frequency: geometric stiffening, which needs the axial strain
     for (line_start, words) in [
         ("gravity (scene)", &["off", "no gravity field"][..]),
-        ("axial (beam)", &["off", "first axial frequency"]),
+        (
+            "geometric_stiffening (beam)",
+            &["on", "first bending frequency"],
+        ),
+        ("axial (beam)", &["on", "geometric stiffening needs"]),
         ("quadratic_velocity (beam)", &["on", "rotates"]),
         (
             "flexibility (beam)",

@@ -344,16 +344,22 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
-    _vUnknown_ref: *const fmi2ValueReference,
-    _nUnknown: usize,
-    _vKnown_ref: *const fmi2ValueReference,
-    _nKnown: usize,
-    _dvKnown: *const fmi2Real,
-    _dvUnknown: *mut fmi2Real,
+    vUnknown_ref: *const fmi2ValueReference,
+    nUnknown: usize,
+    vKnown_ref: *const fmi2ValueReference,
+    nKnown: usize,
+    dvKnown: *const fmi2Real,
+    dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
     unsafe {
         guard(c, Call::GetDirectionalDerivative, |s| {
-            s.get_directional_derivative()
+            // copied first: a master may pass overlapping arrays (dvKnown = dvUnknown)
+            let unknowns = slice(vUnknown_ref, nUnknown, "vUnknown_ref")?.to_vec();
+            let knowns = slice(vKnown_ref, nKnown, "vKnown_ref")?.to_vec();
+            let dv = slice(dvKnown, nKnown, "dvKnown")?.to_vec();
+            let d = s.get_directional_derivative(&unknowns, &knowns, &dv)?;
+            slice_mut(dvUnknown, nUnknown, "dvUnknown")?.copy_from_slice(&d);
+            Ok(())
         })
     }
 }

@@ -81,6 +81,8 @@ impl Instance {
                 | E::InvalidValue { .. }
                 | E::BadStep { .. }
                 | E::BadState { .. }
+                | E::DirectionalDerivative { .. }
+                | E::FeedthroughSingular { .. }
         );
         if let E::BadStep { message } = e {
             // The engine's text starts with "doStep: "; the guard names the function already.
@@ -300,10 +302,17 @@ impl Instance {
         }))
     }
 
-    pub fn get_directional_derivative(&mut self) -> Result<(), Fault> {
-        Err(Fault::refused(
-            "directional derivatives are not provided (providesDirectionalDerivative = false)",
-        ))
+    /// fmi2GetDirectionalDerivative: dv_unknown = (∂ outputs / ∂ inputs) dv_known, exact, at
+    /// the current communication point ([`crate::interface`]).
+    pub fn get_directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+    ) -> Result<Vec<f64>, Fault> {
+        self.engine
+            .directional_derivative(unknowns, knowns, dv_known)
+            .map_err(|e| self.fail(e))
     }
 
     pub fn get_real_output_derivatives(&mut self) -> Result<(), Fault> {

@@ -773,6 +773,62 @@ impl System {
         p
     }
 
+    /// ∂Q/∂u of input `slot`: the generalized force of one unit of that input at (q, q', t),
+    /// from the input loads and effort drives that read it (Q is linear in the inputs), as
+    /// (coordinate, value) pairs; entries of one coordinate add.
+    pub fn input_force(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        t: f64,
+        slot: usize,
+    ) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        let mut push = |f: &FrameState, w: Vector2<f64>, c: f64| {
+            if let Some(b) = f.body {
+                let o = self.offsets[b];
+                f.for_each_jacobian(w, c, |k, x| out.push((o + k, x)));
+            }
+        };
+        for l in &self.loads {
+            let Some(s) = l.inputs.filter(|s| (*s..*s + 3).contains(&slot)) else {
+                continue;
+            };
+            if l.scale.is_some() {
+                continue; // a scaled load does not read its inputs
+            }
+            let fs = self.frame_state(l.frame, q, None);
+            let (w, c) = match slot - s {
+                0 => (Vector2::x(), 0.0),
+                1 => (Vector2::y(), 0.0),
+                _ => (Vector2::zeros(), 1.0),
+            };
+            push(&fs, w, c);
+        }
+        let mut unit = vec![InputValue::default(); self.inputs.len()];
+        unit[slot] = InputValue {
+            value: 1.0,
+            der1: 0.0,
+            der2: 0.0,
+            t0: t,
+        };
+        for j in &self.joints {
+            let reads = j.drive.as_ref().is_some_and(|d| {
+                d.kind == DriveKind::Effort && d.law.law == super::law::Law::Input(slot)
+            });
+            // the effort per unit input: 1, or 0 past the law's `until`
+            let Some(e) = j.effort(t, &unit).filter(|_| reads) else {
+                continue;
+            };
+            let f0 = self.frame_state(j.frames[0], q, Some(v));
+            let f1 = self.frame_state(j.frames[1], q, Some(v));
+            let c = j.coordinate(&f0, &f1);
+            push(&f0, c.w0 * e, c.c0 * e);
+            push(&f1, c.w1 * e, c.c1 * e);
+        }
+        out
+    }
+
     /// Index of the scene joint `name` in `joints`.
     /// The body a frame lies on (`None` for the world).
     pub fn frame_body(&self, frame: usize) -> Option<usize> {

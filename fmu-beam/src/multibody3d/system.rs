@@ -25,6 +25,9 @@ const EPS_FORWARD: f64 = 1e-7;
 /// Step of the second directional difference of g along q' (times max |q'|).
 const EPS_BIAS: f64 = 1e-3;
 
+/// One column of a frame's Jacobian: (coordinate, ∂x/∂q_k, ∂θ/∂q_k).
+pub type FrameColumn = (usize, Vector3<f64>, Vector3<f64>);
+
 /// A world force and torque on a frame, scaled by an optional time law (1 without one).
 #[derive(Debug, Clone)]
 pub struct Load3 {
@@ -430,6 +433,66 @@ impl System3 {
                 (k, force.dot(dx) + torque.dot(&dth))
             })
             .collect()
+    }
+
+    /// Pose of frame `f` and, per coordinate k it depends on, (∂x/∂q_k, ∂θ/∂q_k): the world
+    /// translation and rotation (axial part of ∂A_f A_fᵀ) per unit change of q_k, closed form
+    /// ([`Frame3::pose_derivatives`]). Velocity J q', acceleration J q'' + bias.
+    pub fn frame_jacobian(&self, f: usize, q: &DVector<f64>) -> (Pose, Vec<FrameColumn>) {
+        let mut d = Vec::new();
+        let pose = self.frame_pose_derivatives(f, q, &mut d);
+        let a = pose.1;
+        let cols = self
+            .frame_columns(f)
+            .into_iter()
+            .zip(&d)
+            .map(|(k, (dx, da))| {
+                let w = da * a.transpose();
+                let dth = Vector3::new(
+                    w[(2, 1)] - w[(1, 2)],
+                    w[(0, 2)] - w[(2, 0)],
+                    w[(1, 0)] - w[(0, 1)],
+                ) * 0.5;
+                (k, *dx, dth)
+            })
+            .collect();
+        (pose, cols)
+    }
+
+    /// ∂Q/∂u of input `slot`: the generalized force of one unit of that input at (q, t), from
+    /// the input loads and effort drives that read it (Q is linear in the inputs), as
+    /// (coordinate, value) pairs; entries of one coordinate add.
+    pub fn input_force(&self, q: &DVector<f64>, t: f64, slot: usize) -> Vec<(usize, f64)> {
+        use crate::multibody::law::Law;
+        let mut unit = vec![InputValue::default(); self.inputs.len()];
+        unit[slot] = InputValue {
+            value: 1.0,
+            der1: 0.0,
+            der2: 0.0,
+            t0: t,
+        };
+        let mut out = Vec::new();
+        for l in &self.loads {
+            let Some(law) = l.law.as_ref().filter(|law| law.law == Law::Input(slot)) else {
+                continue;
+            };
+            let s = law.eval(t, &unit).0;
+            out.extend(self.frame_force(l.frame, q, &(l.force * s), &(l.torque * s)));
+        }
+        for (j, jt) in self.joints.iter().enumerate() {
+            let reads = jt.drive.as_ref().is_some_and(|d| {
+                d.kind == crate::scene::DriveKind::Effort && d.law.law == Law::Input(slot)
+            });
+            let Some(e) = jt.effort(t, &unit).filter(|_| reads) else {
+                continue;
+            };
+            out.extend(
+                self.coordinate_gradient(j, q)
+                    .into_iter()
+                    .map(|(k, d)| (k, d * e)),
+            );
+        }
+        out
     }
 
     fn load_scale(&self, l: &Load3, t: f64) -> f64 {

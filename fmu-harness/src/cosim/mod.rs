@@ -23,14 +23,16 @@
 //! values at the start time are read and set (one Jacobi pass).
 
 pub mod extrapolation;
+pub mod joint;
 pub mod system;
 
 use crate::fmi2_binding::{FmuState, LogMessage, Status};
 use crate::simulate::Results;
 use crate::slave::{Causality, Slave, SlaveError, VarType, Variable};
 use extrapolation::History;
+use joint::{JointStats, Joints};
 use std::path::{Path, PathBuf};
-use system::{Algorithm, StartValue, System, SystemError};
+use system::{Algorithm, RollbackSpec, StartValue, System, SystemError};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -63,6 +65,17 @@ pub enum CosimError {
         hint: &'static str,
     },
     #[error(
+        "unit `{unit}` cannot take part in joint `{joint}`: joints need \
+         providesDirectionalDerivative=\"true\" (its interface mobility) and \
+         canGetAndSetFMUstate=\"true\" (the iteration restores the units)"
+    )]
+    JointUnit { unit: String, joint: String },
+    #[error(
+        "at t = {t}: the joints' mobility matrix is singular: a joint direction that no unit \
+         can move (a frame fixed in both units, or the same direction joined twice)"
+    )]
+    JointsSingular { t: f64 },
+    #[error(
         "at t = {t}: the step was refused {halvings} times, down to h = {h} \
          (rollback.max_halvings = {max}); last: {reason}"
     )]
@@ -90,6 +103,10 @@ pub struct Summary {
     pub stop_time: f64,
     /// The reasons of the retries, in order (first few kept).
     pub retry_reasons: Vec<String>,
+    /// fmi2DoStep calls of all units (iterations and retries included).
+    pub unit_steps: u64,
+    /// The joint coupling's counters, when the system has joints.
+    pub joints: Option<JointStats>,
 }
 
 impl Summary {
@@ -107,6 +124,21 @@ impl Summary {
             self.rollbacks,
             self.error_rejections
         );
+        if let Some(j) = &self.joints {
+            let per = |x: u64| x as f64 / self.accepted_steps.max(1) as f64;
+            s.push_str(&format!(
+                "joints: {:.2} iterations and {:.2} restores per step, {:.2} unit steps per step \
+                 ({} in all), {} refused (substeps or no convergence), {} force jumps at events, \
+                 largest accepted mismatch {:.2e} m\n",
+                per(j.iterations),
+                per(j.restores),
+                per(self.unit_steps),
+                self.unit_steps,
+                j.refusals,
+                j.jumps,
+                j.largest_mismatch
+            ));
+        }
         for r in &self.retry_reasons {
             s.push_str(&format!("  retried: {r}\n"));
         }
@@ -158,6 +190,14 @@ enum Refused {
         value: f64,
         bound: String,
     },
+    /// A joint unit took more than one internal step.
+    Substeps { unit: String, steps: i32 },
+    /// The joint iteration did not converge.
+    Joints {
+        iterations: u32,
+        mismatch: f64,
+        tolerance: f64,
+    },
 }
 
 impl Refused {
@@ -179,6 +219,18 @@ impl Refused {
                 value,
                 bound,
             } => format!("check `{variable}` = {value:e} violates {bound}"),
+            Refused::Substeps { unit, steps } => format!(
+                "unit `{unit}` took {steps} internal steps (its Newton iteration retried with \
+                 substeps, which see the joint force inside the step)"
+            ),
+            Refused::Joints {
+                iterations,
+                mismatch,
+                tolerance,
+            } => format!(
+                "the joint forces did not converge in {iterations} iterations: position \
+                 mismatch {mismatch:.3e} m > coupling.tolerance = {tolerance:e}"
+            ),
         }
     }
 }
@@ -210,7 +262,12 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
         name: name.to_string(),
         message,
     };
-    let rollback = system.rollback.as_ref();
+    // joints retry refused steps with half the step even without [rollback]
+    let implied = RollbackSpec::default();
+    let rollback = system
+        .rollback
+        .as_ref()
+        .or((!system.joints.is_empty()).then_some(&implied));
 
     // Load and initialize every unit with its start values.
     let mut units = Vec::with_capacity(system.units.len());
@@ -380,6 +437,15 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
             .map_err(|e| u.fail(e))?;
     }
 
+    let mut joints = if system.joints.is_empty() {
+        None
+    } else {
+        let names: Vec<String> = system.units.iter().map(|u| u.name.clone()).collect();
+        let mut j = Joints::new(&system.joints, &system.coupling, &names, &units, path)?;
+        j.consistent_forces(&mut units, t0)?;
+        Some(j)
+    };
+
     let mut rows = vec![record(&mut units, &recorded, t0)?];
     let order = match system.algorithm {
         Algorithm::Jacobi => (0..units.len()).collect(),
@@ -415,22 +481,41 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
             h_try = h_try.min(h);
         }
         let mut halvings = 0;
+        let mut on_event = false;
         let (h_done, next_h) = loop {
+            if let Some(j) = &joints {
+                // land on the next jump of a unit's laws
+                if let Some(e) = j.next_event(&mut units)? {
+                    if e > t && e < t + h_try && !is_close(e, t + h_try) {
+                        h_try = e - t;
+                    }
+                    on_event = is_close(t + h_try, e);
+                }
+            }
             if rollback.is_some() {
                 for u in units.iter_mut() {
                     let r = u.slave.get_fmu_state(&mut u.state);
                     r.map_err(|e| u.fail(e))?;
                 }
             }
-            let refused = attempt(
-                &mut units,
-                &mut links,
-                &order,
-                system.algorithm,
-                &checks,
-                t,
-                h_try,
-            )?;
+            let mut unit_steps = 0;
+            let mut step = |units: &mut [Unit]| {
+                unit_steps += units.len() as u64;
+                attempt(
+                    units,
+                    &mut links,
+                    &order,
+                    system.algorithm,
+                    &checks,
+                    t,
+                    h_try,
+                )
+            };
+            let refused = match &mut joints {
+                Some(j) => j.step(&mut units, t, h_try, step)?,
+                None => step(&mut units)?,
+            };
+            summary.unit_steps += unit_steps;
             if let Some(why) = refused {
                 let reason = why.text();
                 let r = match rollback {
@@ -505,6 +590,9 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
             grid += 1;
         }
         h = next_h;
+        if let (Some(j), true) = (&mut joints, on_event) {
+            j.consistent_forces(&mut units, t)?;
+        }
         summary.accepted_steps += 1;
         summary.min_step = summary.min_step.min(h_done);
         summary.max_step = summary.max_step.max(h_done);
@@ -524,6 +612,7 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
         r.map_err(|e| u.fail(e))?;
     }
     summary.stop_time = t;
+    summary.joints = joints.map(|j| j.stats);
     if summary.accepted_steps == 0 {
         summary.min_step = 0.0;
     }

@@ -47,6 +47,73 @@ pub struct System {
     pub units: Vec<UnitSpec>,
     #[serde(default)]
     pub connections: Vec<ConnectionSpec>,
+    /// Mechanical joints between units, coupled by their interface forces (`cosim::joint`).
+    #[serde(default, rename = "joint")]
+    pub joints: Vec<JointSpec>,
+    #[serde(default)]
+    pub coupling: CouplingSpec,
+}
+
+/// A mechanical joint between two units: the frames `<unit>.<prefix>` of both carry an input
+/// load (inputs `<prefix>.fx`, `.fy` (, `.fz`)) and offer their motion (outputs `<prefix>.x`,
+/// `.y` (, `.z`) and `<prefix>.ax`, `.ay` (, `.az`)). The first gets the joint force λ, the
+/// second −λ; λ makes the two positions agree at every communication point.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: JointKind,
+    pub frames: [String; 2],
+}
+
+/// What a joint holds together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// A planar pin: positions x, y agree, forces fx, fy.
+    Revolute,
+    /// A 3D ball joint: positions x, y, z agree, forces fx, fy, fz.
+    Spherical,
+}
+
+impl JointKind {
+    /// The world axes the joint holds: the suffixes of its force inputs, positions and
+    /// accelerations.
+    pub fn axes(self) -> &'static [(&'static str, &'static str, &'static str)] {
+        match self {
+            JointKind::Revolute => &[("fx", "x", "ax"), ("fy", "y", "ay")],
+            JointKind::Spherical => &[("fx", "x", "ax"), ("fy", "y", "ay"), ("fz", "z", "az")],
+        }
+    }
+}
+
+/// The iteration of the joint forces in each communication step.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSpec {
+    /// Largest |position mismatch| of any joint at the end of a step (m).
+    #[serde(default = "default_joint_tolerance")]
+    pub tolerance: f64,
+    /// Iterations (each one step of every unit) before the step is refused (and halved).
+    #[serde(default = "default_joint_iterations")]
+    pub max_iterations: u32,
+}
+
+fn default_joint_tolerance() -> f64 {
+    1e-9
+}
+fn default_joint_iterations() -> u32 {
+    10
+}
+
+impl Default for CouplingSpec {
+    fn default() -> Self {
+        CouplingSpec {
+            tolerance: default_joint_tolerance(),
+            max_iterations: default_joint_iterations(),
+        }
+    }
 }
 
 /// Communication step: `size` fixed, or (with `variable`) the first step of the step-size
@@ -98,6 +165,17 @@ impl Extrapolation {
             Extrapolation::None => 0,
             Extrapolation::Linear => 1,
             Extrapolation::Quadratic => 2,
+        }
+    }
+}
+
+/// Retry a step with half the step from the FMU states saved at its start.
+impl Default for RollbackSpec {
+    fn default() -> Self {
+        RollbackSpec {
+            max_halvings: default_max_halvings(),
+            on_discard: true,
+            checks: Vec::new(),
         }
     }
 }
@@ -354,6 +432,44 @@ impl System {
                 ));
             }
         }
+        for (i, j) in self.joints.iter().enumerate() {
+            for (k, f) in j.frames.iter().enumerate() {
+                unit_of(&format!("joint[{i}].frames[{k}]"), f)?;
+            }
+            let units = j.frames.each_ref().map(|f| split_name(f).map(|x| x.0));
+            if units[0] == units[1] {
+                return Err(bad(
+                    &format!("joint[{i}].frames"),
+                    "must name frames of two different units".into(),
+                ));
+            }
+            if self.joints[..i].iter().any(|o| o.name == j.name) {
+                return Err(bad(
+                    &format!("joint[{i}].name"),
+                    format!("= \"{}\": two joints have this name", j.name),
+                ));
+            }
+        }
+        if !self.joints.is_empty() && self.step.variable.is_some() {
+            return Err(bad(
+                "step.variable",
+                "joints are coupled with a fixed communication step (they land on the units' \
+                 events by themselves); remove `variable`"
+                    .into(),
+            ));
+        }
+        if !(self.coupling.tolerance > 0.0 && self.coupling.tolerance.is_finite()) {
+            return Err(bad(
+                "coupling.tolerance",
+                format!("= {}: must be positive and finite", self.coupling.tolerance),
+            ));
+        }
+        if self.coupling.max_iterations == 0 {
+            return Err(bad(
+                "coupling.max_iterations",
+                "= 0: must be at least 1".into(),
+            ));
+        }
         if let Some(r) = &self.rollback {
             for (i, c) in r.checks.iter().enumerate() {
                 let field = format!("rollback.check[{i}]");
@@ -431,6 +547,46 @@ check = [{ variable = "a.e", max = 1.0 }]
         assert_eq!(s.units[0].start["n"], StartValue::Integer(3));
         assert_eq!(s.rollback.as_ref().unwrap().max_halvings, 4);
         assert!(s.rollback.as_ref().unwrap().on_discard);
+    }
+
+    #[test]
+    fn joints_are_read_and_checked() {
+        let joint = "[[joint]]\nname = \"pin\"\ntype = \"revolute\"\nframes = [\"a.p\", \"b.p\"]\n";
+        let s = parse(&format!("{OK}{joint}[coupling]\ntolerance = 1e-8\n")).unwrap();
+        assert_eq!(s.joints[0].kind, JointKind::Revolute);
+        assert_eq!(s.joints[0].frames, ["a.p".to_string(), "b.p".to_string()]);
+        assert_eq!(s.coupling.tolerance, 1e-8);
+        assert_eq!(s.coupling.max_iterations, 10);
+        let cases = [
+            (
+                joint.replace("b.p", "a.q"),
+                "field `joint[0].frames`: must name frames of two different units",
+            ),
+            (
+                joint.replace("b.p", "c.p"),
+                "field `joint[0].frames[1]`: = \"c.p\": no unit named `c`",
+            ),
+            (
+                joint.replace("revolute", "hinge"),
+                "unknown variant `hinge`",
+            ),
+            (
+                format!("{joint}[coupling]\nmax_iterations = 0\n"),
+                "field `coupling.max_iterations`",
+            ),
+        ];
+        for (extra, expected) in cases {
+            let e = parse(&format!("{OK}{extra}")).unwrap_err().to_string();
+            assert!(e.contains(expected), "expected `{expected}` in: {e}");
+        }
+        let variable = OK.replace(
+            "size = 1e-2 }",
+            "size = 1e-2, variable = { min = 1e-3, max = 1e-1, tolerance = 1e-3 } }",
+        );
+        let e = parse(&format!("{variable}{joint}"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("field `step.variable`"), "{e}");
     }
 
     #[test]
