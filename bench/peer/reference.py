@@ -28,10 +28,10 @@ OUT_DIR = os.path.normpath(os.path.join(HERE, '..', 'reference'))
 # (n_elements, step): the last one is the reference; 'elements' and 'step' name the runs
 # one refinement coarser in elements and in step than the reference.
 LADDERS = {
-    'c2': dict(runs=[(32, 2.5e-6), (64, 1e-5), (64, 5e-6), (64, 2.5e-6)],
-               elements=(32, 2.5e-6), step=(64, 5e-6)),
-    'c3_elastic': dict(runs=[(40, 5e-6), (80, 2e-5), (80, 1e-5), (80, 5e-6)],
-                       elements=(40, 5e-6), step=(80, 1e-5)),
+    'c2': dict(runs=[(64, 2.5e-6), (128, 5e-6), (128, 2.5e-6)],
+               elements=(64, 2.5e-6), step=(128, 5e-6)),
+    'c3_elastic': dict(runs=[(80, 5e-6), (160, 1e-5), (160, 5e-6)],
+                       elements=(80, 5e-6), step=(160, 1e-5)),
     'c3_rigid': dict(runs=[(40, 5e-6), (80, 2e-5), (80, 1e-5), (80, 5e-6)],
                      elements=(40, 5e-6), step=(80, 1e-5)),
     'c4_omega10': dict(runs=[(40, 2.5e-4), (80, 1e-3), (80, 5e-4), (80, 2.5e-4)],
@@ -41,8 +41,8 @@ LADDERS = {
 }
 # the reference run of each case (finest in both)
 REFERENCE = {
-    'c2': (64, 2.5e-6),
-    'c3_elastic': (80, 5e-6),
+    'c2': (128, 2.5e-6),
+    'c3_elastic': (160, 5e-6),
     'c3_rigid': (80, 5e-6),
     'c4_omega10': (80, 2.5e-4),
     'c4_omega4': (80, 2.5e-4),
