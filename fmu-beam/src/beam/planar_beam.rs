@@ -166,6 +166,37 @@ pub struct PlanarBeam {
     pub basis: Option<DMatrix<f64>>,
     /// Evaluations of the optional terms.
     pub counts: TermCounts,
+    /// Per deformation coordinate k, the columns l where m_ff, W (either way), K_ff or D_ff
+    /// have a nonzero entry: the element matrices are assembled into a band, so the products
+    /// of each evaluation skip the zeros (bit for bit the same sums).
+    band: Vec<std::ops::Range<usize>>,
+    /// The element's slope rows at the Gauss points and ⟨v'_q v'_qᵀ⟩, constant per beam.
+    strain: StrainRows,
+}
+
+/// The constant parts of an element's nonlinear strain (all elements of a beam are alike).
+#[derive(Debug, Clone, Default)]
+struct StrainRows {
+    /// dv/dx as a row on the element's coordinates, at each point of `GAUSS_4`.
+    slopes: [[f64; ELEMENT_DOFS]; 4],
+    /// Σ w ds dsᵀ over the points: the Hessian of the element mean of v'²/2.
+    hv: [[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
+}
+
+impl StrainRows {
+    fn new(l: f64) -> StrainRows {
+        let mut r = StrainRows::default();
+        for (g, &(xi, w)) in GAUSS_4.iter().enumerate() {
+            let ds = planar_element::slope(xi, l);
+            for p in 0..ELEMENT_DOFS {
+                r.slopes[g][p] = ds[p];
+                for q in 0..ELEMENT_DOFS {
+                    r.hv[p][q] += w * ds[p] * ds[q];
+                }
+            }
+        }
+        r
+    }
 }
 
 /// Full-beam integrals before the boundary conditions remove coordinates.
@@ -305,14 +336,37 @@ impl PlanarBeam {
             options,
             basis: None,
             counts: TermCounts::default(),
+            band: Vec::new(),
+            strain: StrainRows::new(length / elements as f64),
         };
         match options.modes {
             Some(k) => {
                 let k = k.min(beam.kept.len());
-                beam.truncated(k)
+                beam.truncated(k).banded()
             }
-            None => beam,
+            None => beam.banded(),
         }
+    }
+
+    /// The beam with its [`PlanarBeam::band`] found from its matrices.
+    fn banded(mut self) -> PlanarBeam {
+        let nf = self.mff.nrows();
+        self.band = (0..nf)
+            .map(|k| {
+                let nonzero = |l: usize| {
+                    self.mff[(k, l)] != 0.0
+                        || self.mff[(l, k)] != 0.0
+                        || self.w[(k, l)] != 0.0
+                        || self.w[(l, k)] != 0.0
+                        || self.kff[(k, l)] != 0.0
+                        || self.dff[(k, l)] != 0.0
+                };
+                let lo = (0..nf).find(|&l| nonzero(l)).unwrap_or(k);
+                let hi = (0..nf).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
+                lo..hi.max(lo)
+            })
+            .collect();
+        self
     }
 
     /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
@@ -412,7 +466,7 @@ impl PlanarBeam {
                 m[(FLEX + k, i)] = asbar[i];
             }
             let (mut mff_f, mut wt_f) = (0.0, 0.0);
-            for l in 0..nf {
+            for l in self.band[k].clone() {
                 mff_f += self.mff[(k, l)] * f[l];
                 wt_f += self.w[(l, k)] * f[l];
             }
@@ -464,7 +518,7 @@ impl PlanarBeam {
         let (mut a_f, mut f_mff_f, mut mthf_fdd, mut af_fd) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..nf {
             let (mut mff_f, mut mff_fdd, mut wt_f, mut kff_f) = (0.0, 0.0, 0.0, 0.0);
-            for l in 0..nf {
+            for l in self.band[k].clone() {
                 mff_f += self.mff[(k, l)] * f[l];
                 mff_fdd += self.mff[(k, l)] * fdd[l];
                 wt_f += self.w[(l, k)] * f[l];
@@ -478,11 +532,14 @@ impl PlanarBeam {
             if qv {
                 let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
                 af_fd += af * fd[k];
-                let w_fd: f64 = (0..nf).map(|l| self.w[(k, l)] * fd[l]).sum();
+                let w_fd: f64 = self.band[k].clone().map(|l| self.w[(k, l)] * fd[l]).sum();
                 rk -= af * (td * td) + w_fd * (2.0 * td);
             }
             if damping {
-                rk += (0..nf).map(|l| self.dff[(k, l)] * fd[l]).sum::<f64>();
+                rk += self.band[k]
+                    .clone()
+                    .map(|l| self.dff[(k, l)] * fd[l])
+                    .sum::<f64>();
             }
             r[FLEX + k] += rk;
         }
@@ -563,7 +620,7 @@ impl PlanarBeam {
         for k in 0..nf {
             let (asbar, athsbar) = (ar * col2(&self.sbar, k), ath * col2(&self.sbar, k));
             let (mut mff_f, mut w_fdd) = (0.0, 0.0);
-            for l in 0..nf {
+            for l in self.band[k].clone() {
                 mff_f += self.mff[(k, l)] * f[l];
                 w_fdd += self.w[(k, l)] * fdd[l];
             }
@@ -576,7 +633,7 @@ impl PlanarBeam {
             kt[(FLEX + k, THETA)] += d_f_th;
             if qv {
                 let (mut mff_fd, mut w_fd) = (0.0, 0.0);
-                for l in 0..nf {
+                for l in self.band[k].clone() {
                     mff_fd += self.mff[(k, l)] * fd[l];
                     w_fd += self.w[(k, l)] * fd[l];
                 }
@@ -598,14 +655,14 @@ impl PlanarBeam {
             ct[(THETA, THETA)] += 2.0 * af_fd;
         }
         // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff, ∂r_f/∂ḟ = -2θ̇ W + D_ff
-        for l in 0..nf {
-            for k in 0..nf {
+        for k in 0..nf {
+            for l in self.band[k].clone() {
                 kt[(FLEX + k, FLEX + l)] += self.w[(l, k)] * tdd + self.kff[(k, l)];
             }
         }
         if qv {
-            for l in 0..nf {
-                for k in 0..nf {
+            for k in 0..nf {
+                for l in self.band[k].clone() {
                     kt[(FLEX + k, FLEX + l)] -= td * td * self.mff[(k, l)];
                     ct[(FLEX + k, FLEX + l)] -= 2.0 * td * self.w[(k, l)];
                 }
@@ -717,25 +774,21 @@ impl PlanarBeam {
     ) {
         let l = self.length / self.elements as f64;
         let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+        let (slopes, hv) = (&self.strain.slopes, &self.strain.hv);
         for j in 0..self.elements {
             let idx: [Option<usize>; ELEMENT_DOFS] =
                 std::array::from_fn(|p| self.flex_index(3 * j + p));
             let qe: [f64; ELEMENT_DOFS] = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
             let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
             let mut de = da;
-            let mut hv = [[0.0; ELEMENT_DOFS]; ELEMENT_DOFS];
-            for &(xi, w) in &GAUSS_4 {
-                let ds = planar_element::slope(xi, l);
+            for (ds, &(_, w)) in slopes.iter().zip(&GAUSS_4) {
                 let dv: f64 = (0..ELEMENT_DOFS).map(|p| ds[p] * qe[p]).sum();
                 eps += 0.5 * w * dv * dv;
                 for p in 0..ELEMENT_DOFS {
                     de[p] += w * dv * ds[p];
-                    for r in 0..ELEMENT_DOFS {
-                        hv[p][r] += w * ds[p] * ds[r];
-                    }
                 }
             }
-            visit(&idx, l, eps, &de, &hv);
+            visit(&idx, l, eps, &de, hv);
         }
     }
 
