@@ -96,6 +96,33 @@ pub enum Command {
         #[arg(long, value_delimiter = ',')]
         cases: Vec<String>,
     },
+    /// C2–C4 against the exact references of bench/reference and against the peer (Exudyn,
+    /// whose points `bench/peer/sweep.py` writes): the CPU time ratio of the cheapest run of
+    /// each tool that meets 1e-2 … 1e-5; writes ours_points.csv and PEER.md.
+    Peer {
+        /// Directory of the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Directory of the reference CSVs.
+        #[arg(long, default_value = "bench/reference")]
+        references: PathBuf,
+        /// The peer's points (without it, or if it does not exist, only ours are written).
+        #[arg(long, default_value = "build/bench/peer_points.csv")]
+        peer_points: PathBuf,
+        /// Output directory.
+        #[arg(short, long, default_value = "build/bench")]
+        output: PathBuf,
+        /// Timed runs per point (median, min and max are reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// CPU seconds of one run above which the tighter settings of the same formulation
+        /// and integrator mode are skipped.
+        #[arg(long, default_value_t = 4.0)]
+        budget: f64,
+        /// Only these cases (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
+        #[arg(long, value_delimiter = ',')]
+        cases: Vec<String>,
+    },
 }
 
 /// Runs one command, writing its report to `out`.
@@ -159,6 +186,53 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
             }
+        }
+        Command::Peer {
+            scenes,
+            references,
+            peer_points,
+            output,
+            repeats,
+            budget,
+            cases,
+        } => {
+            use work_precision::peer;
+            let chosen: Vec<_> = peer::cases()
+                .into_iter()
+                .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
+                .collect();
+            let started = std::time::Instant::now();
+            let mut progress = |line: &str| eprintln!("{line}");
+            let ours = peer::study(
+                &scenes,
+                &references,
+                &chosen,
+                repeats,
+                budget,
+                &mut progress,
+            )?;
+            let theirs = if peer_points.is_file() {
+                peer::read_peer(&peer_points)?
+            } else {
+                writeln!(
+                    out,
+                    "{} does not exist (run bench/peer/sweep.py): our points only",
+                    peer_points.display()
+                )
+                .map_err(stdout_err)?;
+                Vec::new()
+            };
+            let header = format!(
+                "{} timed runs per point; our sweep took {:.0} s; the peer's points from {}.",
+                repeats,
+                started.elapsed().as_secs_f64(),
+                peer_points.display()
+            );
+            let text = peer::report(&chosen, &ours, &theirs, &header);
+            for path in peer::write(&output, &ours, &text)? {
+                writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
+            }
+            out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
         Command::Simulate {
             fmu,

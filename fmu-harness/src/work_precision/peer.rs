@@ -1,0 +1,553 @@
+//! The peer comparison (`fmu-harness peer`, `make bench-peer`): C2–C4 run by this engine over
+//! formulations and integrator settings, scored against the geometrically exact references of
+//! `bench/reference/` (the same ones `bench/peer/sweep.py` scores Exudyn against), and the table
+//! of CPU time ratios, ours / Exudyn's, of the cheapest run of each tool that meets a target
+//! error. The scenes keep their shipped physics (the effects `auto` would choose); what is
+//! swept is what a user sweeps: elements or substructures, and the fixed step or the tolerance.
+//!
+//! Error: max over the reference's grid of |y − y_ref| / max |y_ref|, as for the peer. Our runs
+//! report every output on that grid (a unit without inputs steps across communication points
+//! and interpolates, so the grid costs no steps).
+
+use super::cases::{Edit, Formulation};
+use super::{thread_cpu_seconds, timed, Series, Setting};
+use crate::error::HarnessError;
+use fmu_beam::{Engine, EngineError, Scene};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What is compared: an output of the unit, or the chord angle of a beam from its tip (root
+/// at the origin), unwrapped.
+#[derive(Debug, Clone, Copy)]
+pub enum Quantity {
+    Output(&'static str),
+    ChordAngle(&'static str),
+}
+
+/// A case of the comparison.
+#[derive(Debug, Clone)]
+pub struct PeerCase {
+    /// As the peer's CSV names it (`c2`, `c3_rigid`, ...).
+    pub name: &'static str,
+    pub title: &'static str,
+    pub scene: &'static str,
+    /// Under `bench/reference/`.
+    pub reference: &'static str,
+    /// (reference column, our quantity).
+    pub outputs: &'static [(&'static str, Quantity)],
+    pub comm: f64,
+    pub stop: f64,
+    pub formulations: Vec<Formulation>,
+    pub settings: Vec<Setting>,
+}
+
+/// The error targets of the table.
+pub const TARGETS: [f64; 4] = [1e-2, 1e-3, 1e-4, 1e-5];
+
+use Edit::*;
+use Setting::{FixedStep as H, Tolerance as Tol};
+
+fn formulation(name: &'static str, edits: &[Edit]) -> Formulation {
+    Formulation {
+        name,
+        edits: edits.to_vec(),
+        settings: None,
+    }
+}
+
+/// The cases, with the formulations and settings swept.
+pub fn cases() -> Vec<PeerCase> {
+    let c3_settings = vec![
+        H(4e-3),
+        H(2e-3),
+        H(1e-3),
+        H(5e-4),
+        H(2e-4),
+        H(1e-4),
+        H(5e-5),
+        Tol(1e-4),
+        Tol(1e-5),
+        Tol(1e-6),
+        Tol(1e-7),
+    ];
+    let c4_settings = vec![
+        H(2e-2),
+        H(1e-2),
+        H(5e-3),
+        H(2e-3),
+        H(1e-3),
+        Tol(1e-4),
+        Tol(1e-5),
+        Tol(1e-6),
+        Tol(1e-7),
+    ];
+    vec![
+        PeerCase {
+            name: "c2",
+            title: "C2 flexible pendulum (1 s)",
+            scene: "flexible_pendulum_substructured.toml",
+            reference: "c2.csv",
+            outputs: &[
+                ("chord_angle", Quantity::ChordAngle("beam")),
+                ("tip_deflection", Quantity::Output("beam.tip.deflection")),
+            ],
+            comm: 1e-3,
+            stop: 1.0,
+            formulations: vec![
+                formulation("5 x 2 substructures", &[Substructures("beam", 5, 2)]),
+                formulation("10 x 2 substructures", &[Substructures("beam", 10, 2)]),
+                formulation("20 x 2 substructures", &[Substructures("beam", 20, 2)]),
+                formulation("single frame, 10 elements", &[Elements("beam", 10)]),
+                formulation("single frame, 6 elements", &[Elements("beam", 6)]),
+                formulation("single frame, 4 elements", &[Elements("beam", 4)]),
+                formulation("3 x 2 substructures", &[Substructures("beam", 3, 2)]),
+            ],
+            settings: vec![
+                H(5e-3),
+                H(2e-3),
+                H(1e-3),
+                H(5e-4),
+                H(2e-4),
+                H(1e-4),
+                Tol(1e-4),
+                Tol(1e-5),
+                Tol(1e-6),
+                Tol(1e-7),
+                Tol(1e-8),
+            ],
+        },
+        PeerCase {
+            name: "c3_elastic",
+            title: "C3 slider-crank, elastic crank (1.6 s)",
+            scene: "slider_crank.toml",
+            reference: "c3_elastic.csv",
+            outputs: &[
+                ("slider_position", Quantity::Output("slider.position")),
+                ("rod_mid_deflection", Quantity::Output("rod.mid.deflection")),
+            ],
+            comm: 1e-3,
+            stop: 1.6,
+            formulations: vec![
+                formulation(
+                    "crank 3, rod 8",
+                    &[Elements("crank", 3), Elements("rod", 8)],
+                ),
+                formulation(
+                    "crank 2, rod 4",
+                    &[Elements("crank", 2), Elements("rod", 4)],
+                ),
+                formulation(
+                    "crank 6, rod 16",
+                    &[Elements("crank", 6), Elements("rod", 16)],
+                ),
+            ],
+            settings: c3_settings.clone(),
+        },
+        PeerCase {
+            name: "c3_rigid",
+            title: "C3 slider-crank, rigid crank (1.6 s)",
+            scene: "slider_crank_rigid_crank.toml",
+            reference: "c3_rigid.csv",
+            outputs: &[
+                ("slider_position", Quantity::Output("slider.position")),
+                ("rod_mid_deflection", Quantity::Output("rod.mid.deflection")),
+            ],
+            comm: 1e-3,
+            stop: 1.6,
+            formulations: vec![
+                formulation("rod 4", &[Elements("rod", 4)]),
+                formulation("rod 8", &[Elements("rod", 8)]),
+                formulation("rod 16", &[Elements("rod", 16)]),
+            ],
+            settings: c3_settings,
+        },
+        PeerCase {
+            name: "c4_omega10",
+            title: "C4 spin-up to Ω = 10 rad/s (20 s)",
+            scene: "spin_up_omega10.toml",
+            reference: "c4_omega10.csv",
+            outputs: &[("tip_deflection", Quantity::Output("beam.tip.deflection"))],
+            comm: 1e-2,
+            stop: 20.0,
+            formulations: vec![
+                formulation("5 x 1 substructures", &[Substructures("beam", 5, 1)]),
+                formulation("10 x 1 substructures", &[Substructures("beam", 10, 1)]),
+                formulation("20 x 1 substructures", &[Substructures("beam", 20, 1)]),
+            ],
+            settings: c4_settings.clone(),
+        },
+        PeerCase {
+            name: "c4_omega4",
+            title: "C4 spin-up to Ω = 4 rad/s (20 s)",
+            scene: "spin_up_omega4.toml",
+            reference: "c4_omega4.csv",
+            outputs: &[("tip_deflection", Quantity::Output("beam.tip.deflection"))],
+            comm: 1e-2,
+            stop: 20.0,
+            formulations: vec![
+                formulation("3 x 1 substructures", &[Substructures("beam", 3, 1)]),
+                formulation("5 x 1 substructures", &[Substructures("beam", 5, 1)]),
+                formulation("10 x 1 substructures", &[Substructures("beam", 10, 1)]),
+            ],
+            settings: c4_settings,
+        },
+    ]
+}
+
+/// One point of ours or of the peer: errors per output, CPU seconds (median, min, max).
+#[derive(Debug, Clone)]
+pub struct PeerPoint {
+    pub case: String,
+    pub output: String,
+    pub tool: String,
+    pub formulation: String,
+    pub setting: String,
+    pub error: f64,
+    pub seconds: [f64; 3],
+    pub steps: i64,
+}
+
+/// Columns of a reference CSV: names and rows.
+fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), HarnessError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| HarnessError::io(path, "reading the reference", e))?;
+    let bad = |what: &str| HarnessError::Input {
+        origin: path.display().to_string(),
+        message: what.to_string(),
+    };
+    let mut lines = text.lines();
+    let names: Vec<String> = lines
+        .next()
+        .ok_or_else(|| bad("empty"))?
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<Vec<f64>, _>>()
+                .map_err(|_| bad("a row of numbers expected"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if rows.iter().any(|r| r.len() != names.len()) {
+        return Err(bad("rows of another length than the header"));
+    }
+    Ok((names, rows))
+}
+
+/// The scene of a formulation at a setting. Fixed steps keep the scene's tolerance (it only
+/// stops Newton, whose error does not pile up over many steps: issue 12); error control keeps
+/// the scene's largest step.
+fn configure(base: &Scene, f: &Formulation, setting: Setting) -> Result<Scene, HarnessError> {
+    let mut s = f.apply(base);
+    match setting {
+        Setting::Tolerance(t) => {
+            s.solver.adaptive = true;
+            s.solver.tolerance = t;
+        }
+        Setting::FixedStep(h) => {
+            s.solver.adaptive = false;
+            s.solver.max_step = h;
+        }
+    }
+    let origin = format!("{} ({}, {setting})", base.name, f.name);
+    Ok(Scene::from_toml_str(&s.to_toml_string(), &origin)?)
+}
+
+/// Runs `scene` over the case's grid; values per output of the case.
+fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
+    let start = Instant::now();
+    let cpu0 = thread_cpu_seconds();
+    let mut e = Engine::new(scene.clone());
+    e.exit_initialization()?;
+    let vr = |e: &Engine, n: String| {
+        e.variables()
+            .by_name(&n)
+            .map(|v| v.vr)
+            .ok_or(EngineError::BadStep {
+                message: format!("the unit has no output {n}"),
+            })
+    };
+    let mut reads = Vec::new();
+    for (_, q) in case.outputs {
+        reads.push(match q {
+            Quantity::Output(n) => vec![vr(&e, n.to_string())?],
+            Quantity::ChordAngle(b) => {
+                vec![vr(&e, format!("{b}.tip.x"))?, vr(&e, format!("{b}.tip.y"))?]
+            }
+        });
+    }
+    let n = (case.stop / case.comm).round() as usize;
+    let mut values = vec![Vec::with_capacity(n + 1); case.outputs.len()];
+    for k in 0..=n {
+        if k > 0 {
+            e.do_step((k - 1) as f64 * case.comm, case.comm)?;
+        }
+        for (o, vrs) in reads.iter().enumerate() {
+            let y = match vrs[..] {
+                [v] => e.get_real(v)?,
+                [x, y] => {
+                    let a = e.get_real(y)?.atan2(e.get_real(x)?);
+                    // unwrapped: continuous through −π
+                    let tau = 2.0 * std::f64::consts::PI;
+                    values[o]
+                        .last()
+                        .map_or(a, |&p: &f64| a + tau * ((p - a) / tau).round())
+                }
+                _ => f64::NAN,
+            };
+            values[o].push(y);
+        }
+    }
+    let seconds = match (cpu0, thread_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => start.elapsed().as_secs_f64(),
+    };
+    let steps = e
+        .variables()
+        .by_name("solver.steps")
+        .map(|v| v.vr)
+        .map_or(Ok(0), |v| e.get_integer(v))?;
+    Ok(Series {
+        values,
+        missing: Vec::new(),
+        seconds,
+        stats: [steps as i64, 0, 0],
+    })
+}
+
+/// Runs every case; `progress` receives a line per point. A setting whose run of a formulation
+/// took more than `budget` CPU seconds ends that formulation's tighter settings of the same
+/// mode.
+pub fn study(
+    scenes: &Path,
+    references: &Path,
+    cases: &[PeerCase],
+    repeats: usize,
+    budget: f64,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<PeerPoint>, HarnessError> {
+    let mut points = Vec::new();
+    for case in cases {
+        let base = Scene::load(&scenes.join(case.scene))?;
+        let (names, rows) = read_reference(&references.join(case.reference))?;
+        let n = (case.stop / case.comm).round() as usize + 1;
+        if rows.len() != n {
+            return Err(HarnessError::Input {
+                origin: case.reference.into(),
+                message: format!("{} rows, {n} expected on the case's grid", rows.len()),
+            });
+        }
+        let mut columns = Vec::new();
+        for (col, _) in case.outputs {
+            let k = names
+                .iter()
+                .position(|c| c == col)
+                .ok_or(HarnessError::Input {
+                    origin: case.reference.into(),
+                    message: format!("no column {col}"),
+                })?;
+            columns.push(rows.iter().map(|r| r[k]).collect::<Vec<f64>>());
+        }
+        for f in &case.formulations {
+            let mut over_budget = [false; 2];
+            for &setting in &case.settings {
+                let mode = matches!(setting, Setting::FixedStep(_)) as usize;
+                if over_budget[mode] {
+                    continue;
+                }
+                let scene = configure(&base, f, setting)?;
+                let run = || simulate(&scene, case);
+                let line = match timed(&run, repeats) {
+                    Ok((s, seconds, _)) => {
+                        if seconds[0] > budget {
+                            over_budget[mode] = true;
+                        }
+                        let mut line =
+                            format!("{} {}, {setting}: {:.3} s", case.name, f.name, seconds[0]);
+                        for ((col, _), (y, r)) in
+                            case.outputs.iter().zip(s.values.iter().zip(&columns))
+                        {
+                            let (_, rel) = super::error(y, r);
+                            let _ = write!(line, ", {col} {rel:.2e}");
+                            points.push(PeerPoint {
+                                case: case.name.into(),
+                                output: col.to_string(),
+                                tool: "fmu-beam".into(),
+                                formulation: f.name.into(),
+                                setting: setting.to_string(),
+                                error: rel,
+                                seconds,
+                                steps: s.stats[0],
+                            });
+                        }
+                        line
+                    }
+                    Err(e) => format!("{} {}, {setting}: failed: {e}", case.name, f.name),
+                };
+                progress(&line);
+            }
+        }
+    }
+    Ok(points)
+}
+
+/// The peer's points from `bench/peer/sweep.py`'s CSV.
+pub fn read_peer(path: &Path) -> Result<Vec<PeerPoint>, HarnessError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| HarnessError::io(path, "reading the peer's points", e))?;
+    let bad = |m: String| HarnessError::Input {
+        origin: path.display().to_string(),
+        message: m,
+    };
+    let mut points = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let f = split_csv(line);
+        if f.len() != 10 {
+            return Err(bad(format!("line {}: 10 fields expected", i + 1)));
+        }
+        let num = |k: usize| {
+            f[k].parse::<f64>()
+                .map_err(|_| bad(format!("line {}: field {} is not a number", i + 1, k + 1)))
+        };
+        points.push(PeerPoint {
+            case: f[0].clone(),
+            output: f[1].clone(),
+            tool: f[2].clone(),
+            formulation: f[3].clone(),
+            setting: f[4].clone(),
+            error: num(5)?,
+            seconds: [num(6)?, num(7)?, num(8)?],
+            steps: f[9].parse().unwrap_or(0),
+        });
+    }
+    Ok(points)
+}
+
+/// Fields of a CSV line, double quotes honoured.
+fn split_csv(line: &str) -> Vec<String> {
+    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    for c in line.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+            c => cur.push(c),
+        }
+    }
+    fields.push(cur);
+    fields
+}
+
+/// The cheapest point (median CPU) meeting `target`, among those of `tool` for (case, output).
+fn cheapest<'a>(
+    points: &'a [PeerPoint],
+    tool: &str,
+    case: &str,
+    output: &str,
+    target: f64,
+) -> Option<&'a PeerPoint> {
+    points
+        .iter()
+        .filter(|p| p.tool == tool && p.case == case && p.output == output && p.error <= target)
+        .min_by(|a, b| a.seconds[0].total_cmp(&b.seconds[0]))
+}
+
+/// `ours.csv`-style text of points.
+pub fn csv(points: &[PeerPoint]) -> String {
+    let mut s = String::from(
+        "case,output,tool,formulation,setting,error,cpu_median,cpu_min,cpu_max,steps\n",
+    );
+    for p in points {
+        let _ = writeln!(
+            s,
+            "{},{},{},\"{}\",{},{:.6e},{:.6e},{:.6e},{:.6e},{}",
+            p.case,
+            p.output,
+            p.tool,
+            p.formulation,
+            p.setting,
+            p.error,
+            p.seconds[0],
+            p.seconds[1],
+            p.seconds[2],
+            p.steps
+        );
+    }
+    s
+}
+
+/// The report: the ratio table, then per target the two runs that set each ratio.
+pub fn report(
+    cases: &[PeerCase],
+    ours: &[PeerPoint],
+    theirs: &[PeerPoint],
+    header: &str,
+) -> String {
+    let mut s =
+        format!("# Against the peer: fmu-beam and Exudyn at equal accuracy\n\n{header}\n\n");
+    s += "CPU time of the cheapest run of each tool whose largest error against the exact \
+          reference (`bench/reference/`) is at most the target, as the ratio ours / Exudyn's \
+          (median of the timed runs; below 1: we are faster). `ours n.r.`: our sweep does not \
+          reach the target; `peer n.r.`: Exudyn's does not.\n\n";
+    s += "| case, output |";
+    for t in TARGETS {
+        let _ = write!(s, " {t:.0e} |");
+    }
+    s += "\n|---|";
+    s += &"---|".repeat(TARGETS.len());
+    s += "\n";
+    let mut details = String::new();
+    for case in cases {
+        for (col, _) in case.outputs {
+            let _ = write!(s, "| {} {col} |", case.name);
+            for t in TARGETS {
+                let a = cheapest(ours, "fmu-beam", case.name, col, t);
+                let b = cheapest(theirs, "exudyn", case.name, col, t);
+                let cell = match (a, b) {
+                    (Some(a), Some(b)) => format!("{:.2}", a.seconds[0] / b.seconds[0]),
+                    (None, Some(_)) => "ours n.r.".into(),
+                    (Some(_), None) => "peer n.r.".into(),
+                    (None, None) => "-".into(),
+                };
+                let _ = write!(s, " {cell} |");
+                let show = |p: Option<&PeerPoint>| {
+                    p.map_or("not reached".to_string(), |p| {
+                        format!(
+                            "{} at {}: error {:.2e}, {:.4} s ({:.4}–{:.4})",
+                            p.formulation,
+                            p.setting,
+                            p.error,
+                            p.seconds[0],
+                            p.seconds[1],
+                            p.seconds[2]
+                        )
+                    })
+                };
+                let _ = writeln!(
+                    details,
+                    "| {} {col} | {t:.0e} | {} | {} |",
+                    case.name,
+                    show(a),
+                    show(b)
+                );
+            }
+            s += "\n";
+        }
+    }
+    s += "\n## The runs behind each ratio\n\n| case, output | target | fmu-beam | Exudyn |\n|---|---|---|---|\n";
+    s += &details;
+    s
+}
+
+/// Writes `ours.csv` and `PEER.md` into `dir`; returns their paths.
+pub fn write(dir: &Path, ours: &[PeerPoint], report: &str) -> Result<Vec<PathBuf>, HarnessError> {
+    std::fs::create_dir_all(dir).map_err(|e| HarnessError::io(dir, "creating the directory", e))?;
+    let a = dir.join("ours_points.csv");
+    std::fs::write(&a, csv(ours)).map_err(|e| HarnessError::io(&a, "writing", e))?;
+    let b = dir.join("PEER.md");
+    std::fs::write(&b, report).map_err(|e| HarnessError::io(&b, "writing", e))?;
+    Ok(vec![a, b])
+}
