@@ -153,7 +153,7 @@ struct Series {
 
 /// CPU seconds this thread has run, from the scheduler's account; None where Linux does not
 /// offer it.
-fn thread_cpu_seconds() -> Option<f64> {
+pub(crate) fn thread_cpu_seconds() -> Option<f64> {
     std::fs::read_to_string("/proc/thread-self/schedstat")
         .ok()?
         .split_whitespace()

@@ -27,12 +27,13 @@ pub enum LinearSolver {
 
 /// Systems with at least this many unknowns (n + m), of which no body holds more than
 /// [`SPARSE_MAX_BLOCK_SHARE`], are factorized sparse under [`LinearSolver::Auto`]. Measured
-/// (docs/linear_algebra.md): on chains of substructures the sparse LU costs 1.0–1.1 × the dense
-/// one per factorization at n + m = 45–59 and 0.7 × at 63–83, per step 0.93–1.0 × and 0.86–0.96 ×.
+/// (docs/linear_algebra.md): on chains of substructures the sparse LU costs 1.0 × the dense
+/// one per factorization at n + m = 45–59 and 0.65–0.7 × at 63–83; per step 1.0 × and
+/// 0.87–0.92 ×; below 40 the dense one is faster (1.1–1.7 ×).
 pub const SPARSE_MIN_SIZE: usize = 60;
 /// The largest share of the unknowns one body may hold for the sparse LU to be chosen: one
-/// beam is one dense block, which the sparse LU factorizes no faster per step (C1 with 20–80
-/// elements: 1.02–1.09 × the dense time per step).
+/// beam is one dense block, which the sparse LU factorizes no faster (C1 with 20–80 elements:
+/// 1.0–1.1 × the dense time per step, 1.1–2.7 × per factorization).
 pub const SPARSE_MAX_BLOCK_SHARE: f64 = 0.5;
 
 /// The rule of [`LinearSolver::Auto`]: sparse for n + m ≥ [`SPARSE_MIN_SIZE`] unknowns of which
