@@ -205,8 +205,9 @@ impl IterationMatrix {
         self.factored
     }
 
-    /// Solves in place with the factors; false when there are none or the solution is not
-    /// finite (a pivot that vanished in the sparse LU).
+    /// Solves in place with the factors; false when there are none or a finite right-hand
+    /// side gives a solution that is not (a pivot that vanished in the sparse LU). A right-hand
+    /// side that is not finite is the caller's to notice, as with the dense LU.
     pub fn solve_mut(&mut self, rhs: &mut DVector<f64>) -> bool {
         if !self.factored {
             return false;
@@ -215,8 +216,9 @@ impl IterationMatrix {
         match &mut self.factors {
             Factors::Dense { lu, .. } => lu.as_ref().is_some_and(|lu| lu.solve_mut(rhs)),
             Factors::Sparse(s) => {
+                let finite = rhs.iter().all(|x| x.is_finite());
                 s.solve_mut(rhs.as_mut_slice());
-                rhs.iter().all(|x| x.is_finite())
+                !finite || rhs.iter().all(|x| x.is_finite())
             }
         }
     }
