@@ -8,7 +8,7 @@
 //! the per-round ratios sparse / dense. Writes `LINEAR.md` and `linear_solvers.csv`.
 
 use crate::error::HarnessError;
-use crate::work_precision::thread_cpu_seconds;
+use crate::work_precision::clock;
 use fmu_beam::effects::resolve;
 use fmu_beam::integrator::{
     initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
@@ -72,11 +72,6 @@ const COMM: f64 = 1e-2;
 fn spread(mut s: Vec<f64>) -> [f64; 3] {
     s.sort_by(f64::total_cmp);
     [s[s.len() / 2], s[0], s[s.len() - 1]]
-}
-
-/// CPU seconds of the thread (wall seconds since `start` where Linux does not count them).
-fn clock(start: Instant) -> f64 {
-    thread_cpu_seconds().unwrap_or_else(|| start.elapsed().as_secs_f64())
 }
 
 /// One model with one solver: what it is, its counters and its samples (s per unit).

@@ -153,7 +153,7 @@ struct Series {
 
 /// CPU seconds this thread has run, from the scheduler's account; None where Linux does not
 /// offer it.
-pub(crate) fn thread_cpu_seconds() -> Option<f64> {
+fn thread_cpu_seconds() -> Option<f64> {
     std::fs::read_to_string("/proc/thread-self/schedstat")
         .ok()?
         .split_whitespace()
@@ -214,7 +214,7 @@ fn simulate(scene: &Scene, case: &Case) -> Result<Series, EngineError> {
 }
 
 /// CPU seconds of the thread, or wall seconds since `start` where Linux does not offer them.
-fn clock(start: Instant) -> f64 {
+pub(crate) fn clock(start: Instant) -> f64 {
     thread_cpu_seconds().unwrap_or_else(|| start.elapsed().as_secs_f64())
 }
 
