@@ -60,10 +60,13 @@ check:
 
 # Work-precision study (fmu-harness work-precision): every case C1-C4 over formulations, integrator
 # settings and effects, then the 3D section (C5, C6, the fast variants; `--cases 3D` runs it alone);
-# build/bench/REPORT.md, points.csv, <case>.png, and the README's chart.
+# build/bench/REPORT.md, points.csv, <case>.png, and the README's chart. Then dense against sparse
+# LU of the iteration matrix by number of substructures (fmu-harness linear-solvers):
+# build/bench/LINEAR.md and linear_solvers.csv (the table of docs/linear_algebra.md).
 # (tests/bench_c1.py, C1 timed through fmpy, runs by hand: $(PY) tests/bench_c1.py)
 bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench
+	$(HARNESS) linear-solvers --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy

@@ -11,7 +11,7 @@
 use crate::effects::Effects;
 use crate::integrator::{initial_state, Settings, Stats, Stepper};
 use crate::multibody::joint::Joint;
-use crate::multibody::System;
+use crate::multibody::{Equations, System};
 use crate::scene::{EffectsSpec, Scene};
 use nalgebra::{DMatrix, Vector2};
 

@@ -6,11 +6,13 @@ use crate::effects::Effects;
 use crate::error::EngineError;
 use crate::multibody::equations::{CoordinateKind, Equations};
 use crate::multibody::law::InputValue;
+use crate::multibody::sparsity::{BlockDiagonal, JacobianRows};
 use crate::multibody::System;
 use crate::multibody3d::build::{self, SceneIndex};
 use crate::multibody3d::System3;
 use crate::scene::Scene;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
+use std::ops::Range;
 
 #[derive(Debug, Clone)]
 pub enum Mechanics {
@@ -76,8 +78,14 @@ impl Equations for Mechanics {
             Mechanics::Spatial(s, _) => Equations::initial_coordinates(s, scene),
         }
     }
-    fn mass_matrix(&self, q: &DVector<f64>, m: &mut DMatrix<f64>) {
-        each!(self, s => Equations::mass_matrix(s, q, m))
+    fn body_ranges(&self) -> Vec<Range<usize>> {
+        each!(self, s => Equations::body_ranges(s))
+    }
+    fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        each!(self, s => Equations::row_bodies(s))
+    }
+    fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        each!(self, s => Equations::mass_blocks(s, q, m))
     }
     fn body_residual(
         &self,
@@ -89,32 +97,32 @@ impl Equations for Mechanics {
     ) {
         each!(self, s => Equations::body_residual(s, q, v, a, t, r))
     }
-    fn tangents(
+    fn tangent_blocks(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
         lambda: &DVector<f64>,
         t: f64,
-        kt: &mut DMatrix<f64>,
-        ct: &mut DMatrix<f64>,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
     ) {
-        each!(self, s => Equations::tangents(s, q, v, a, lambda, t, kt, ct))
+        each!(self, s => Equations::tangent_blocks(s, q, v, a, lambda, t, kt, ct))
     }
     fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
         each!(self, s => Equations::constraints(s, q, t, g))
     }
-    fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
-        each!(self, s => Equations::constraint_jacobian(s, q, t, g))
+    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, gm: &mut JacobianRows) {
+        each!(self, s => Equations::jacobian_rows(s, q, t, gm))
     }
-    fn constraints_and_jacobian(
+    fn constraints_and_rows(
         &self,
         q: &DVector<f64>,
         t: f64,
         g: &mut DVector<f64>,
-        gm: &mut DMatrix<f64>,
+        gm: &mut JacobianRows,
     ) {
-        each!(self, s => Equations::constraints_and_jacobian(s, q, t, g, gm))
+        each!(self, s => Equations::constraints_and_rows(s, q, t, g, gm))
     }
     fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
         each!(self, s => Equations::accel_bias(s, q, v, t, out))

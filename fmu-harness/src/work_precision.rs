@@ -215,7 +215,7 @@ fn simulate(scene: &Scene, case: &Case) -> Result<Series, EngineError> {
 }
 
 /// CPU seconds of the thread, or wall seconds since `start` where Linux does not offer them.
-fn clock(start: Instant) -> f64 {
+pub(crate) fn clock(start: Instant) -> f64 {
     thread_cpu_seconds().unwrap_or_else(|| start.elapsed().as_secs_f64())
 }
 

@@ -9,11 +9,12 @@
 //! - M. Géradin, A. Cardona (2001), Flexible Multibody Dynamics, §11 (error estimate
 //!   h²(β - 1/6)(a_{n+1} - a_n)).
 
+use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA};
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::multibody::{CoordinateKind, Equations};
-use nalgebra::{DMatrix, DVector, Dyn, LU};
+use crate::multibody::{CoordinateKind, Equations, JacobianRows};
+use nalgebra::DVector;
 
 /// The integration state at a step boundary.
 #[derive(Debug, PartialEq)]
@@ -81,6 +82,26 @@ impl Coefficients {
             beta,
         }
     }
+
+    /// The blocks' coefficients of the scaled iteration matrix at step h: the residual rows
+    /// times d = βh², so d K_t + β' d M + γ' d C_t with β' = (1 − α_m)/(βh²(1 − α_f)) and
+    /// γ' = γ/(βh).
+    fn scaling(&self, h: f64) -> Scaling {
+        let d = self.beta * h * h;
+        let beta_p = (1.0 - self.alpha_m) / (d * (1.0 - self.alpha_f));
+        let gamma_p = self.gamma / (self.beta * h);
+        Scaling {
+            d,
+            cm: beta_p * d,
+            cc: gamma_p * d,
+        }
+    }
+}
+
+/// The scaling of the iteration matrix for spectral radius ρ∞ and step h (what
+/// [`Stepper`] factorizes; for timing the factorization alone).
+pub fn iteration_scaling(rho_inf: f64, h: f64) -> Scaling {
+    Coefficients::new(rho_inf).scaling(h)
 }
 
 const MAX_NEWTON: usize = 16;
@@ -172,16 +193,14 @@ pub struct Stepper {
     scale: DVector<f64>,
     /// Coordinates of massless bodies.
     algebraic: Vec<usize>,
-    lu: Option<LU<f64, Dyn, Dyn>>,
+    /// The iteration matrix, factorized or not.
+    matrix: IterationMatrix,
     memory: Memory,
     /// The last fixed step cut short: time, size and why (the engine logs it).
     pub last_split: Option<(f64, f64, SplitReason)>,
     // workspace
-    mm: DMatrix<f64>,
-    kt: DMatrix<f64>,
-    ct: DMatrix<f64>,
-    gm: DMatrix<f64>,
-    jac: DMatrix<f64>,
+    /// G at the current iterate (the residual's Gᵀλ).
+    gm: JacobianRows,
     r: DVector<f64>,
     g: DVector<f64>,
     rhs: DVector<f64>,
@@ -200,7 +219,18 @@ enum Failure {
 }
 
 impl Stepper {
+    /// The integrator for `sys`, its iteration matrix factorized dense or sparse by the
+    /// system's size ([`LinearSolver::Auto`]).
     pub fn new<S: Equations + ?Sized>(sys: &S, settings: Settings) -> Stepper {
+        Stepper::with_linear_solver(sys, settings, LinearSolver::Auto)
+    }
+
+    /// The integrator for `sys` with the iteration matrix factorized as `linear` says.
+    pub fn with_linear_solver<S: Equations + ?Sized>(
+        sys: &S,
+        settings: Settings,
+        linear: LinearSolver,
+    ) -> Stepper {
         let (n, m) = (sys.n(), sys.m());
         let mut scale = DVector::zeros(n);
         for (k, kind) in sys.coordinate_kinds().into_iter().enumerate() {
@@ -218,14 +248,10 @@ impl Stepper {
             settings,
             scale,
             algebraic,
-            lu: None,
+            matrix: IterationMatrix::new(sys, linear),
             memory: Memory::default(),
             last_split: None,
-            mm: DMatrix::zeros(n, n),
-            kt: DMatrix::zeros(n, n),
-            ct: DMatrix::zeros(n, n),
-            gm: DMatrix::zeros(m, n),
-            jac: DMatrix::zeros(n + m, n + m),
+            gm: sys.jacobian_pattern(),
             r: DVector::zeros(n),
             g: DVector::zeros(m),
             rhs: DVector::zeros(n + m),
@@ -240,7 +266,7 @@ impl Stepper {
     /// Puts back a saved memory: the iteration matrix is factorized again at its point when
     /// the next step needs it.
     pub fn restore_memory(&mut self, memory: Memory) {
-        self.lu = None;
+        self.matrix.forget();
         self.memory = memory;
     }
 
@@ -260,7 +286,7 @@ impl Stepper {
 
     /// Drops the iteration matrix.
     fn forget(&mut self) {
-        self.lu = None;
+        self.matrix.forget();
         self.memory.point = None;
         self.memory.contraction.fresh();
     }
@@ -511,32 +537,13 @@ impl Stepper {
         h: f64,
         c: &Coefficients,
     ) -> bool {
-        let (n, m) = (sys.n(), sys.m());
-        let d = c.beta * h * h;
-        let beta_p = (1.0 - c.alpha_m) / (d * (1.0 - c.alpha_f));
-        let gamma_p = c.gamma / (c.beta * h);
-        sys.mass_matrix(q, &mut self.mm);
-        sys.tangents(q, v, qdd, lambda, t, &mut self.kt, &mut self.ct);
-        sys.constraint_jacobian(q, t, &mut self.gm);
-        let (cm, cc) = (beta_p * d, gamma_p * d);
-        for j in 0..n {
-            for i in 0..n {
-                self.jac[(i, j)] =
-                    self.kt[(i, j)] * d + self.mm[(i, j)] * cm + self.ct[(i, j)] * cc;
-            }
-            for k in 0..m {
-                self.jac[(n + k, j)] = self.gm[(k, j)];
-                self.jac[(j, n + k)] = self.gm[(k, j)];
-            }
-        }
-        self.jac.view_mut((n, n), (m, m)).fill(0.0);
-        let lu = self.jac.clone().lu();
-        if !lu.is_invertible() {
-            self.lu = None;
-            return false;
-        }
-        self.lu = Some(lu);
-        true
+        self.matrix
+            .factorize(sys, q, v, qdd, lambda, t, c.scaling(h))
+    }
+
+    /// Whether the iteration matrix is factorized sparse.
+    pub fn is_sparse(&self) -> bool {
+        self.matrix.is_sparse()
     }
 
     /// One step of size h from `st`; returns the new state and the local error norm.
@@ -562,7 +569,7 @@ impl Stepper {
             self.forget();
         }
         // a restored state: the same factors, at the same point
-        if self.lu.is_none() {
+        if !self.matrix.is_factored() {
             if let Some(p) = self.memory.point.take() {
                 if !self.factorize(sys, &p.q, &p.v, &p.qdd, &p.lambda, p.t, p.h, &c) {
                     self.forget();
@@ -591,7 +598,7 @@ impl Stepper {
         let increment = self.norm((&q - &st.q).iter(), &q);
         let kappa = KAPPA.min(INCREMENT_SHARE * self.settings.tolerance * increment);
         for it in 0..MAX_NEWTON {
-            if self.lu.is_none() {
+            if !self.matrix.is_factored() {
                 if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c) {
                     self.forget();
                     return Err(Failure::Singular);
@@ -614,16 +621,16 @@ impl Stepper {
                 prev = f64::INFINITY;
             }
             sys.body_residual(&q, &v, &qdd, t_new, &mut self.r);
-            sys.constraints_and_jacobian(&q, t_new, &mut self.g, &mut self.gm);
-            self.r.gemv_tr(1.0, &self.gm, &lambda, 1.0);
+            sys.constraints_and_rows(&q, t_new, &mut self.g, &mut self.gm);
+            self.gm.add_transpose_times(&lambda, &mut self.r);
             for i in 0..n {
                 self.rhs[i] = -d * self.r[i];
             }
             for k in 0..m {
                 self.rhs[n + k] = -self.g[k];
             }
-            let lu = self.lu.as_ref().ok_or(Failure::Singular)?;
-            if !lu.solve_mut(&mut self.rhs) {
+            if !self.matrix.solve_mut(&mut self.rhs) {
+                self.forget();
                 return Err(Failure::Singular);
             }
             stats.newton_iterations += 1;
@@ -686,7 +693,7 @@ impl Stepper {
                     // the solution, or steps ago) is evaluated again at the current iterate,
                     // close to the solution: Newton's own quadratic convergence
                     if self.memory.contraction.stalls() && k > 2 && refreshed < MAX_REFRESH {
-                        self.lu = None;
+                        self.matrix.forget();
                         refreshed += 1;
                     }
                 }

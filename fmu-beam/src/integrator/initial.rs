@@ -1,6 +1,7 @@
 //! Consistent initial conditions: assemble the mechanism (g(q) = 0), then solve for the
 //! accelerations and multipliers that the equations of motion give at rest.
 
+use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::{GaState, Settings};
 use crate::error::EngineError;
 use crate::multibody::Equations;
@@ -122,7 +123,8 @@ fn check_rank<S: Equations + ?Sized>(
     })
 }
 
-/// Solves [[M, Gᵀ], [G, 0]] [q''; λ] = [-r(q, q', 0); -bias].
+/// Solves [[M, Gᵀ], [G, 0]] [q''; λ] = [-r(q, q', 0); -bias], dense or sparse by the system's
+/// size ([`LinearSolver::Auto`]).
 pub fn consistent_accelerations<S: Equations + ?Sized>(
     sys: &S,
     q: &DVector<f64>,
@@ -130,30 +132,30 @@ pub fn consistent_accelerations<S: Equations + ?Sized>(
     t: f64,
 ) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
     let (n, m) = (sys.n(), sys.m());
-    let mut mm = DMatrix::zeros(n, n);
-    sys.mass_matrix(q, &mut mm);
-    let mut gm = DMatrix::zeros(m, n);
-    sys.constraint_jacobian(q, t, &mut gm);
     let mut r = DVector::zeros(n);
     sys.body_residual(q, v, &DVector::zeros(n), t, &mut r);
     let mut bias = DVector::zeros(m);
     sys.accel_bias(q, v, t, &mut bias);
-    let mut a = DMatrix::zeros(n + m, n + m);
-    a.view_mut((0, 0), (n, n)).copy_from(&mm);
-    a.view_mut((0, n), (n, m)).copy_from(&gm.transpose());
-    a.view_mut((n, 0), (m, n)).copy_from(&gm);
-    let mut rhs = DVector::zeros(n + m);
-    rhs.rows_mut(0, n).copy_from(&(-r));
-    rhs.rows_mut(n, m).copy_from(&(-bias));
-    let x = a
-        .lu()
-        .solve(&rhs)
-        .filter(|x| x.iter().all(|v| v.is_finite()))
-        .ok_or_else(|| EngineError::InitialState {
+    let mut x = DVector::zeros(n + m);
+    x.rows_mut(0, n).copy_from(&(-r));
+    x.rows_mut(n, m).copy_from(&(-bias));
+    let mut matrix = IterationMatrix::new(sys, LinearSolver::Auto);
+    let w = Scaling {
+        d: 0.0,
+        cm: 1.0,
+        cc: 0.0,
+    };
+    let (zero_n, zero_m) = (DVector::zeros(n), DVector::zeros(m));
+    let solved = matrix.factorize(sys, q, v, &zero_n, &zero_m, t, w)
+        && matrix.solve_mut(&mut x)
+        && x.iter().all(|v| v.is_finite());
+    if !solved {
+        return Err(EngineError::InitialState {
             message: format!(
                 "the mass matrix is singular at t = {t} s on motions the joints leave free \
                  (a body without mass or inertia that nothing holds)"
             ),
-        })?;
+        });
+    }
     Ok((x.rows(0, n).into_owned(), x.rows(n, m).into_owned()))
 }

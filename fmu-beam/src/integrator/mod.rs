@@ -3,10 +3,14 @@
 pub mod dense_output;
 pub mod generalized_alpha;
 pub mod initial;
+pub mod iteration_matrix;
 pub mod newton;
 
-pub use generalized_alpha::{GaState, MatrixPoint, Memory, SplitReason, Stepper};
+pub use generalized_alpha::{
+    iteration_scaling, GaState, MatrixPoint, Memory, SplitReason, Stepper,
+};
 pub use initial::initial_state;
+pub use iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 
 use crate::engine::{write_vec, Reader};
 use crate::error::EngineError;

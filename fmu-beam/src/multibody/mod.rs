@@ -8,8 +8,10 @@ pub mod law;
 pub mod prismatic;
 pub mod revolute;
 pub mod rigid_body;
+pub mod sparsity;
 pub mod system;
 pub mod weld;
 
 pub use equations::{CoordinateKind, Equations};
+pub use sparsity::{BlockDiagonal, JacobianRows};
 pub use system::System;

@@ -8,6 +8,7 @@ use super::frame::{self, Frame, FrameState};
 use super::joint::{Drive, Joint, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
+use super::sparsity::{BlockDiagonal, JacobianRows};
 use crate::beam::planar_beam::TermCounts;
 use crate::beam::planar_beam::{rot, PlanarBeam, PointMap};
 use crate::effects::Effects;
@@ -487,7 +488,7 @@ impl System {
     /// Adds J_pᵀ w + J_φ c of frame `f` into row `row` of `out`.
     fn add_row_jacobian(
         &self,
-        out: &mut DMatrix<f64>,
+        out: &mut JacobianRows,
         row: usize,
         f: &FrameState,
         w: Vector2<f64>,
@@ -495,13 +496,37 @@ impl System {
     ) {
         if let Some(b) = f.body {
             let o = self.offsets[b];
-            f.for_each_jacobian(w, c, |k, x| out[(row, o + k)] += x);
+            f.for_each_jacobian(w, c, |k, x| out.add(row, o + k, x));
         }
     }
 
-    /// Constraint Jacobian G = ∂g/∂q (m × n), overwritten.
-    pub fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
-        g.fill(0.0);
+    /// Coordinates of each body in q.
+    pub fn body_ranges(&self) -> Vec<Range<usize>> {
+        self.bodies
+            .iter()
+            .zip(&self.offsets)
+            .map(|(b, &o)| o..o + b.ndof())
+            .collect()
+    }
+
+    /// For each constraint row, the bodies of its joint's two frames.
+    pub fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        let mut rows = vec![[None, None]; self.m];
+        for j in &self.joints {
+            let body = |f: usize| match &self.frames[f] {
+                Frame::World { .. } => None,
+                Frame::OnBody { body, .. } => Some(*body),
+            };
+            let bodies = [body(j.frames[0]), body(j.frames[1])];
+            let count = Joint::rows_count(j.kind, j.drive.as_ref());
+            rows[j.row..j.row + count].fill(bodies);
+        }
+        rows
+    }
+
+    /// Constraint Jacobian G = ∂g/∂q by rows, overwritten.
+    pub fn jacobian_rows(&self, q: &DVector<f64>, t: f64, g: &mut JacobianRows) {
+        g.fill_zero();
         for j in &self.joints {
             let (f0, f1, rows) = self.joint_rows(j, q, None, t);
             for (k, r) in rows.iter().enumerate() {
@@ -511,15 +536,16 @@ impl System {
         }
     }
 
-    /// Constraint residual g(q, t) and Jacobian G (overwritten) in one pass over the joints.
-    pub fn constraints_and_jacobian(
+    /// Constraint residual g(q, t) and Jacobian G by rows (overwritten) in one pass over the
+    /// joints.
+    pub fn constraints_and_rows(
         &self,
         q: &DVector<f64>,
         t: f64,
         g: &mut DVector<f64>,
-        gm: &mut DMatrix<f64>,
+        gm: &mut JacobianRows,
     ) {
-        gm.fill(0.0);
+        gm.fill_zero();
         for j in &self.joints {
             let (f0, f1, rows) = self.joint_rows(j, q, None, t);
             for (k, r) in rows.iter().enumerate() {
@@ -540,15 +566,12 @@ impl System {
         }
     }
 
-    /// Mass matrix M(q), overwritten.
-    pub fn mass_matrix(&self, q: &DVector<f64>, m: &mut DMatrix<f64>) {
-        m.fill(0.0);
+    /// Mass matrix M(q) by body blocks, overwritten.
+    pub fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        m.fill_zero();
         for (i, b) in self.bodies.iter().enumerate() {
-            let o = self.offsets[i];
-            b.mass_matrix(
-                self.body_coords(i, q),
-                m.view_mut((o, o), (b.ndof(), b.ndof())),
-            );
+            let n = b.ndof();
+            b.mass_matrix(self.body_coords(i, q), m.blocks[i].view_mut((0, 0), (n, n)));
         }
     }
 
@@ -620,49 +643,48 @@ impl System {
 
     fn add_force_tangent(
         &self,
-        kt: &mut DMatrix<f64>,
+        kt: &mut BlockDiagonal,
         frame: usize,
         q: &DVector<f64>,
         force: Vector2<f64>,
     ) {
         if let Frame::OnBody { body, map } = &self.frames[frame] {
             let b = &self.bodies[*body];
-            let o = self.offsets[*body];
+            let n = b.ndof();
             frame::add_force_tangent(
                 b,
                 map,
                 self.body_coords(*body, q),
                 force,
-                kt.view_mut((o, o), (b.ndof(), b.ndof())),
+                kt.blocks[*body].view_mut((0, 0), (n, n)),
             );
         }
     }
 
-    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q', overwritten. The terms from the
-    /// rotation of a prismatic axis and of effort drives are left out (Newton converges
-    /// without them).
-    pub fn tangents(
+    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten. The terms
+    /// from the rotation of a prismatic axis and of effort drives are left out (Newton
+    /// converges without them); a reaction or load only acts on its own body's block.
+    pub fn tangent_blocks(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
         lambda: &DVector<f64>,
         t: f64,
-        kt: &mut DMatrix<f64>,
-        ct: &mut DMatrix<f64>,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
     ) {
-        kt.fill(0.0);
-        ct.fill(0.0);
+        kt.fill_zero();
+        ct.fill_zero();
         for (i, b) in self.bodies.iter().enumerate() {
-            let o = self.offsets[i];
             let n = b.ndof();
             b.tangents(
                 self.body_coords(i, q),
                 self.body_coords(i, v),
                 self.body_coords(i, a),
                 self.gravity,
-                kt.view_mut((o, o), (n, n)),
-                ct.view_mut((o, o), (n, n)),
+                kt.blocks[i].view_mut((0, 0), (n, n)),
+                ct.blocks[i].view_mut((0, 0), (n, n)),
             );
         }
         for j in &self.joints {
@@ -916,8 +938,14 @@ impl super::equations::Equations for System {
     fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
         System::initial_coordinates(self, scene)
     }
-    fn mass_matrix(&self, q: &DVector<f64>, m: &mut DMatrix<f64>) {
-        System::mass_matrix(self, q, m)
+    fn body_ranges(&self) -> Vec<Range<usize>> {
+        System::body_ranges(self)
+    }
+    fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        System::row_bodies(self)
+    }
+    fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        System::mass_blocks(self, q, m)
     }
     fn body_residual(
         &self,
@@ -929,32 +957,32 @@ impl super::equations::Equations for System {
     ) {
         System::body_residual(self, q, v, a, t, r)
     }
-    fn tangents(
+    fn tangent_blocks(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
         lambda: &DVector<f64>,
         t: f64,
-        kt: &mut DMatrix<f64>,
-        ct: &mut DMatrix<f64>,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
     ) {
-        System::tangents(self, q, v, a, lambda, t, kt, ct)
+        System::tangent_blocks(self, q, v, a, lambda, t, kt, ct)
     }
     fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
         System::constraints(self, q, t, g)
     }
-    fn constraint_jacobian(&self, q: &DVector<f64>, t: f64, g: &mut DMatrix<f64>) {
-        System::constraint_jacobian(self, q, t, g)
+    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, gm: &mut JacobianRows) {
+        System::jacobian_rows(self, q, t, gm)
     }
-    fn constraints_and_jacobian(
+    fn constraints_and_rows(
         &self,
         q: &DVector<f64>,
         t: f64,
         g: &mut DVector<f64>,
-        gm: &mut DMatrix<f64>,
+        gm: &mut JacobianRows,
     ) {
-        System::constraints_and_jacobian(self, q, t, g, gm)
+        System::constraints_and_rows(self, q, t, g, gm)
     }
     fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
         System::accel_bias(self, q, v, t, out)

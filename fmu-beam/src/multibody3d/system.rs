@@ -13,6 +13,7 @@ use crate::error::EngineError;
 use crate::multibody::equations::{CoordinateKind, Equations};
 use crate::multibody::joint::Drive;
 use crate::multibody::law::{InputValue, TimeLaw};
+use crate::multibody::sparsity::{BlockDiagonal, JacobianRows};
 use crate::multibody::system::Energy;
 use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector, DVectorView, Matrix3, Vector3};
@@ -597,12 +598,28 @@ impl Equations for System3 {
         Ok(DVector::from_vec(self.initial.clone()))
     }
 
-    fn mass_matrix(&self, q: &DVector<f64>, m: &mut DMatrix<f64>) {
-        m.fill(0.0);
+    fn body_ranges(&self) -> Vec<Range<usize>> {
+        self.bodies
+            .iter()
+            .zip(&self.offsets)
+            .map(|(b, &o)| o..o + b.ncoords())
+            .collect()
+    }
+
+    /// A norm row on its body; a joint's rows on the bodies of its two frames.
+    fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        let mut rows: Vec<[Option<usize>; 2]> =
+            (0..self.bodies.len()).map(|i| [Some(i), None]).collect();
+        for j in &self.joints {
+            let bodies = j.frames.map(|f| self.frames[f].body());
+            rows.extend(std::iter::repeat_n(bodies, j.len()));
+        }
+        rows
+    }
+
+    fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
         for (i, b) in self.bodies.iter().enumerate() {
-            let (o, n) = (self.offsets[i], b.ncoords());
-            m.view_mut((o, o), (n, n))
-                .copy_from(&b.mass_matrix(self.body_coords(i, q)));
+            m.blocks[i].copy_from(&b.mass_matrix(self.body_coords(i, q)));
         }
     }
 
@@ -633,32 +650,33 @@ impl Equations for System3 {
     /// Per body, forward differences of its residual over its own coordinates and rates; the
     /// norm rows' 2λ I exactly. Joint and load geometric terms are left out (Newton converges
     /// without them at the step sizes the dynamics need).
-    fn tangents(
+    fn tangent_blocks(
         &self,
         q: &DVector<f64>,
         v: &DVector<f64>,
         a: &DVector<f64>,
         lambda: &DVector<f64>,
         _t: f64,
-        kt: &mut DMatrix<f64>,
-        ct: &mut DMatrix<f64>,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
     ) {
-        kt.fill(0.0);
-        ct.fill(0.0);
+        kt.fill_zero();
+        ct.fill_zero();
         let g = self.gravity.unwrap_or_default();
         for (i, b) in self.bodies.iter().enumerate() {
-            let (o, n) = (self.offsets[i], b.ncoords());
+            let n = b.ncoords();
+            let kb = &mut kt.blocks[i];
             b.tangents(
                 self.body_coords(i, q),
                 self.body_coords(i, v),
                 self.body_coords(i, a),
                 &g,
                 EPS_FORWARD,
-                kt.view_mut((o, o), (n, n)),
-                ct.view_mut((o, o), (n, n)),
+                kb.view_mut((0, 0), (n, n)),
+                ct.blocks[i].view_mut((0, 0), (n, n)),
             );
             for k in 0..4 {
-                kt[(o + 3 + k, o + 3 + k)] += 2.0 * lambda[i];
+                kb[(3 + k, 3 + k)] += 2.0 * lambda[i];
             }
         }
     }
@@ -676,11 +694,11 @@ impl Equations for System3 {
 
     /// Norm rows 2pᵀ; joint rows in closed form, each column the rows' derivative along the
     /// pose derivatives of one coordinate ([`Joint3::rows_acceleration`] at zero rates).
-    fn constraint_jacobian(&self, q: &DVector<f64>, _t: f64, gm: &mut DMatrix<f64>) {
-        gm.fill(0.0);
+    fn jacobian_rows(&self, q: &DVector<f64>, _t: f64, gm: &mut JacobianRows) {
+        gm.fill_zero();
         for (i, &o) in self.offsets.iter().enumerate() {
             for k in 0..4 {
-                gm[(i, o + 3 + k)] = 2.0 * q[o + 3 + k];
+                gm.add(i, o + 3 + k, 2.0 * q[o + 3 + k]);
             }
         }
         let nb = self.bodies.len();
@@ -699,7 +717,7 @@ impl Equations for System3 {
                     j.rows_acceleration(&p0, &p1, &zero, &zero, a0, a1, &mut col[..l]);
                     let c = self.offsets[b] + k;
                     for s in 0..l {
-                        gm[(r + s, c)] += col[s];
+                        gm.add(r + s, c, col[s]);
                     }
                 }
             }

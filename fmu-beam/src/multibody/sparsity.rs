@@ -1,0 +1,194 @@
+//! The sparsity of a multibody system's matrices, fixed when the system is built: M, K_t and C_t
+//! are block diagonal over the bodies' coordinates ([`BlockDiagonal`]), and each constraint row
+//! depends on the coordinates of at most two bodies, the bodies of its joint's frames
+//! ([`JacobianRows`]). Work on them is O(Σ block² + nnz(G)) instead of O(n²) and O(m n).
+
+use nalgebra::{DMatrix, DVector};
+use std::ops::Range;
+
+/// A block-diagonal matrix: one dense block per body, over the body's coordinates in q.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockDiagonal {
+    /// Coordinates of each block (consecutive, covering 0..n).
+    pub ranges: Vec<Range<usize>>,
+    pub blocks: Vec<DMatrix<f64>>,
+}
+
+impl BlockDiagonal {
+    /// Zero blocks over `ranges`.
+    pub fn zeros(ranges: &[Range<usize>]) -> BlockDiagonal {
+        BlockDiagonal {
+            ranges: ranges.to_vec(),
+            blocks: ranges
+                .iter()
+                .map(|r| DMatrix::zeros(r.len(), r.len()))
+                .collect(),
+        }
+    }
+
+    pub fn fill_zero(&mut self) {
+        for b in &mut self.blocks {
+            b.fill(0.0);
+        }
+    }
+
+    /// Writes the whole n × n matrix (zeros off the blocks) into `out`.
+    pub fn to_dense(&self, out: &mut DMatrix<f64>) {
+        out.fill(0.0);
+        for (r, b) in self.ranges.iter().zip(&self.blocks) {
+            out.view_mut((r.start, r.start), (r.len(), r.len()))
+                .copy_from(b);
+        }
+    }
+}
+
+/// Columns of one constraint row over one body: `len` columns from `col`, values from `at`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Segment {
+    col: usize,
+    len: usize,
+    at: usize,
+}
+
+/// The constraint Jacobian G (m × n) by rows: row i holds the columns of the (at most two)
+/// bodies its joint's frames move with, stored densely over each body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JacobianRows {
+    n: usize,
+    segments: Vec<[Segment; 2]>,
+    values: Vec<f64>,
+}
+
+impl JacobianRows {
+    /// The pattern of a system: `ranges` the bodies' coordinates, `rows` the bodies each
+    /// constraint row depends on (`None` for a world frame).
+    pub fn new(n: usize, ranges: &[Range<usize>], rows: &[[Option<usize>; 2]]) -> JacobianRows {
+        let mut at = 0;
+        let segments = rows
+            .iter()
+            .map(|bodies| {
+                let mut b: Vec<usize> = bodies.iter().flatten().copied().collect();
+                b.sort_unstable();
+                b.dedup();
+                let mut s = [Segment::default(); 2];
+                for (k, &body) in b.iter().enumerate() {
+                    let r = &ranges[body];
+                    s[k] = Segment {
+                        col: r.start,
+                        len: r.len(),
+                        at,
+                    };
+                    at += r.len();
+                }
+                s
+            })
+            .collect();
+        JacobianRows {
+            n,
+            segments,
+            values: vec![0.0; at],
+        }
+    }
+
+    /// Number of rows (m).
+    pub fn nrows(&self) -> usize {
+        self.segments.len()
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.values.len()
+    }
+
+    pub fn fill_zero(&mut self) {
+        self.values.fill(0.0);
+    }
+
+    /// Adds x to G[row, col]; `col` must lie on a body of the row's pattern.
+    #[inline]
+    pub fn add(&mut self, row: usize, col: usize, x: f64) {
+        let k = self
+            .index(row, col)
+            .unwrap_or_else(|| panic!("G[{row}, {col}] is outside the constraint row's bodies"));
+        self.values[k] += x;
+    }
+
+    /// Where G[row, col] is stored, if it lies in the pattern.
+    fn index(&self, row: usize, col: usize) -> Option<usize> {
+        self.segments[row]
+            .iter()
+            .find(|s| col >= s.col && col < s.col + s.len)
+            .map(|s| s.at + col - s.col)
+    }
+
+    /// Visits (row, col, index of the stored value) of every stored entry, row by row.
+    pub fn for_each_entry(&self, mut visit: impl FnMut(usize, usize, usize)) {
+        for (row, segs) in self.segments.iter().enumerate() {
+            for s in segs {
+                for c in 0..s.len {
+                    visit(row, s.col + c, s.at + c);
+                }
+            }
+        }
+    }
+
+    /// The stored values, in the order [`JacobianRows::for_each_entry`] visits them.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// r += Gᵀ λ.
+    pub fn add_transpose_times(&self, lambda: &DVector<f64>, r: &mut DVector<f64>) {
+        for (row, segs) in self.segments.iter().enumerate() {
+            let l = lambda[row];
+            for s in segs {
+                let g = &self.values[s.at..s.at + s.len];
+                for (rc, x) in r.as_mut_slice()[s.col..s.col + s.len].iter_mut().zip(g) {
+                    *rc += x * l;
+                }
+            }
+        }
+    }
+
+    /// Writes the whole m × n matrix (zeros off the pattern) into `out`.
+    pub fn to_dense(&self, out: &mut DMatrix<f64>) {
+        assert_eq!(out.shape(), (self.nrows(), self.n));
+        out.fill(0.0);
+        self.for_each_entry(|row, col, k| out[(row, col)] = self.values[k]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_over_two_bodies_multiply_and_expand_like_the_dense_matrix() {
+        let ranges = [0..2, 2..5, 5..6];
+        let rows = [[None, Some(1)], [Some(0), Some(2)], [Some(2), Some(2)]];
+        let mut g = JacobianRows::new(6, &ranges, &rows);
+        assert_eq!(g.nnz(), 3 + 3 + 1);
+        g.add(0, 3, 2.0);
+        g.add(1, 0, -1.0);
+        g.add(1, 5, 4.0);
+        g.add(2, 5, 0.5);
+        g.add(2, 5, 0.25);
+        let mut d = DMatrix::zeros(3, 6);
+        g.to_dense(&mut d);
+        assert_eq!(d[(0, 3)], 2.0);
+        assert_eq!(d[(1, 0)], -1.0);
+        assert_eq!(d[(2, 5)], 0.75);
+        let lambda = DVector::from_vec(vec![1.0, 2.0, 3.0]);
+        let mut r = DVector::from_element(6, 1.0);
+        g.add_transpose_times(&lambda, &mut r);
+        let expected = DVector::from_element(6, 1.0) + d.transpose() * &lambda;
+        assert_eq!(r, expected);
+    }
+
+    #[test]
+    #[should_panic(expected = "outside")]
+    fn an_entry_off_the_pattern_is_a_bug() {
+        let mut g = JacobianRows::new(4, &[0..2, 2..4], &[[Some(0), None]]);
+        g.add(0, 3, 1.0);
+    }
+}

@@ -1,0 +1,184 @@
+//! The iteration matrix factorized sparse (faer's LU) against dense (nalgebra's): the assembly
+//! from body blocks and constraint rows solves the system that the dense matrices of
+//! `Equations` give, on a planar chain and on a 3D one; runs on either path agree to rounding;
+//! `LinearSolver::Auto` follows its rule; and a model on the sparse path restores its FMU state
+//! bit for bit.
+
+mod common;
+
+use common::{scene, vr};
+use fmu_beam::effects::resolve;
+use fmu_beam::integrator::iteration_matrix::{prefers_sparse, SPARSE_MIN_SIZE};
+use fmu_beam::integrator::{
+    initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
+    Stepper,
+};
+use fmu_beam::mechanics::Mechanics;
+use fmu_beam::multibody::Equations;
+use fmu_beam::{Engine, Scene};
+use nalgebra::{DMatrix, DVector};
+
+/// `file` with its first beam in `k` substructures (of its own elements each), at a fixed step.
+fn substructured(file: &str, k: usize, step: f64) -> Scene {
+    let mut s = scene(file);
+    s.beams[0].substructures = Some(k);
+    s.solver.adaptive = false;
+    s.solver.max_step = step;
+    s.solver.tolerance = 1e-10;
+    Scene::from_toml_str(&s.to_toml_string(), file).expect("valid")
+}
+
+fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
+    let sys = Mechanics::build(s, &resolve(s).effects);
+    let settings = Settings::from_scene(s);
+    let st = initial_state(&sys, s, 0.0, &settings).expect("assembles");
+    (sys, st, settings)
+}
+
+/// [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]] from the dense methods of `Equations`.
+fn dense_matrix(sys: &Mechanics, st: &GaState, h: f64, rho_inf: f64) -> DMatrix<f64> {
+    let (n, m) = (sys.n(), sys.m());
+    let (mut mm, mut kt, mut ct) = (
+        DMatrix::zeros(n, n),
+        DMatrix::zeros(n, n),
+        DMatrix::zeros(n, n),
+    );
+    let mut g = DMatrix::zeros(m, n);
+    sys.mass_matrix(&st.q, &mut mm);
+    sys.tangents(&st.q, &st.v, &st.qdd, &st.lambda, st.t, &mut kt, &mut ct);
+    sys.constraint_jacobian(&st.q, st.t, &mut g);
+    let w = iteration_scaling(rho_inf, h);
+    let mut a = DMatrix::zeros(n + m, n + m);
+    a.view_mut((0, 0), (n, n))
+        .copy_from(&(kt * w.d + mm * w.cm + ct * w.cc));
+    a.view_mut((0, n), (n, m)).copy_from(&g.transpose());
+    a.view_mut((n, 0), (m, n)).copy_from(&g);
+    a
+}
+
+/// Both factorizations of the assembled matrix solve what the dense matrices give.
+fn solves_like_the_dense_matrices(s: &Scene) {
+    let (sys, st, settings) = built(s);
+    let a = dense_matrix(&sys, &st, settings.max_step, settings.rho_inf);
+    let dim = a.nrows();
+    let b = DVector::from_fn(dim, |i, _| (i as f64 * 0.7).sin() + 0.1);
+    let w = iteration_scaling(settings.rho_inf, settings.max_step);
+    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let mut matrix = IterationMatrix::new(&sys, linear);
+        assert_eq!(matrix.is_sparse(), linear == LinearSolver::Sparse);
+        assert!(matrix.factorize(&sys, &st.q, &st.v, &st.qdd, &st.lambda, st.t, w));
+        let mut x = b.clone();
+        assert!(matrix.solve_mut(&mut x));
+        let residual = (&a * &x - &b).amax() / b.amax();
+        println!(
+            "{}: n + m = {dim}, {linear:?}: nnz {}, |A x - b| / |b| = {residual:.1e}",
+            s.name,
+            matrix.nnz()
+        );
+        assert!(residual < 1e-10, "{linear:?}: {residual:e}");
+    }
+}
+
+#[test]
+fn both_factorizations_solve_the_assembled_planar_and_spatial_chains() {
+    solves_like_the_dense_matrices(&substructured(
+        "flexible_pendulum_substructured.toml",
+        8,
+        1e-3,
+    ));
+    solves_like_the_dense_matrices(&substructured("spin_up_omega10.toml", 6, 1e-2));
+    solves_like_the_dense_matrices(&substructured("rollup_3d.toml", 4, 1e-3));
+}
+
+/// Final coordinates of a fixed-step run on each path.
+fn runs_agree(s: &Scene, stop: f64) {
+    let (sys, st0, settings) = built(s);
+    let mut ends = Vec::new();
+    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let mut st = st0.clone();
+        let mut stepper = Stepper::with_linear_solver(&sys, settings, linear);
+        let mut stats = Stats::default();
+        stepper
+            .step_to(&sys, &mut st, &mut stats, stop)
+            .expect("steps");
+        assert_eq!(stepper.is_sparse(), linear == LinearSolver::Sparse);
+        ends.push((st.q, stats));
+    }
+    let diff = (&ends[0].0 - &ends[1].0).amax();
+    println!(
+        "{}: {} steps, dense {} / sparse {} Newton iterations, max |Δq| = {diff:.1e}",
+        s.name, ends[0].1.steps, ends[0].1.newton_iterations, ends[1].1.newton_iterations
+    );
+    assert_eq!(ends[0].1.steps, ends[1].1.steps);
+    assert!(diff < 1e-10 * ends[0].0.amax().max(1.0), "{diff:e}");
+}
+
+#[test]
+fn dense_and_sparse_runs_agree_to_rounding() {
+    runs_agree(
+        &substructured("flexible_pendulum_substructured.toml", 12, 1e-3),
+        0.1,
+    );
+    runs_agree(&substructured("rollup_3d.toml", 5, 1e-3), 0.02);
+}
+
+#[test]
+fn auto_is_dense_for_small_systems_and_one_dominant_body_and_sparse_for_long_chains() {
+    let size = |s: &Scene| {
+        let sys = Mechanics::build(s, &resolve(s).effects);
+        let largest = sys.body_ranges().iter().map(|r| r.len()).max().unwrap();
+        let auto = IterationMatrix::new(&sys, LinearSolver::Auto).is_sparse();
+        (sys.n() + sys.m(), largest, auto)
+    };
+    let (n, _, auto) = size(&scene("flexible_pendulum.toml"));
+    assert!(
+        !auto && n < SPARSE_MIN_SIZE,
+        "one frame of 10 elements: {n}"
+    );
+    let mut c1 = scene("cantilever_free_vibration.toml");
+    c1.beams[0].elements = Some(60);
+    let (n, l, auto) = size(&c1);
+    assert!(
+        !auto && n >= SPARSE_MIN_SIZE,
+        "one beam of 60 elements: {n}, block {l}"
+    );
+    let (n, l, auto) = size(&substructured("spin_up_omega10.toml", 40, 1e-2));
+    assert!(
+        auto && prefers_sparse(n, l),
+        "C4 with 40 substructures: {n}"
+    );
+}
+
+/// FMU state of a model on the sparse path (C2 with 20 substructures): a snapshot taken
+/// mid-run, restored or deserialized, continues bit for bit (the factors are not in the
+/// state: they are computed again at the stored point).
+#[test]
+fn a_sparse_model_restores_its_state_bit_for_bit() {
+    let mut s = scene("flexible_pendulum_substructured.toml");
+    s.beams[0].substructures = Some(20);
+    let s = Scene::from_toml_str(&s.to_toml_string(), "c2_k20.toml").unwrap();
+    let sys = Mechanics::build(&s, &resolve(&s).effects);
+    assert!(IterationMatrix::new(&sys, LinearSolver::Auto).is_sparse());
+    let mut e = Engine::new(s);
+    let angle = vr(&e, "hinge.angle");
+    e.exit_initialization().unwrap();
+    for k in 0..10 {
+        e.do_step(k as f64 * 0.01, 0.01).unwrap();
+    }
+    let snap = e.snapshot();
+    let bytes = e.serialize(&snap);
+    let run = |e: &mut Engine| -> Vec<u64> {
+        (10..25)
+            .map(|k| {
+                e.do_step(k as f64 * 0.01, 0.01).unwrap();
+                e.get_real(angle).unwrap().to_bits()
+            })
+            .collect()
+    };
+    let first = run(&mut e);
+    e.restore(&snap).unwrap();
+    assert_eq!(run(&mut e), first);
+    let back = e.deserialize(&bytes).unwrap();
+    e.restore(&back).unwrap();
+    assert_eq!(run(&mut e), first);
+}
