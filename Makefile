@@ -52,8 +52,10 @@ fmus: release
 	done; \
 	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
 
+# C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus
 	$(PY) tests/demo.py
+	$(PY) tests/demo_animations.py
 
 test: .venv tools browser fmus
 	cargo test --workspace --release --no-fail-fast
