@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools browser release fmus demo test check bench example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser release fmus demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -76,6 +76,22 @@ bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench
 	$(HARNESS) linear-solvers --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
+
+# Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
+# and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
+# steps or tolerances (fmu-harness peer, about 6 min), both scored against the exact references
+# of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy.
+VENV_BENCH  := .venv-bench
+BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp
+$(BENCH_STAMP): requirements-bench.txt
+	$(PYTHON3) -m venv $(VENV_BENCH)
+	$(VENV_BENCH)/bin/pip install --quiet -r requirements-bench.txt
+	touch $@
+
+bench-peer: $(BENCH_STAMP) release
+	mkdir -p build/bench
+	$(VENV_BENCH)/bin/python bench/peer/sweep.py
+	$(HARNESS) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).
