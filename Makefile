@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools release fmus demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser release fmus demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -27,6 +27,12 @@ $(STAMP): requirements.txt
 tools:
 	@command -v gcc >/dev/null && command -v valgrind >/dev/null || { \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind gcc libc6-dev; }
+
+# The browser the animation tests open the HTML player in: Debian's chromium (Playwright, from
+# requirements.txt, drives it; it downloads no browser of its own).
+browser:
+	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || { \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
 
 release:
 	cargo build --release --workspace
@@ -46,10 +52,12 @@ fmus: release
 	done; \
 	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
 
+# C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus
 	$(PY) tests/demo.py
+	$(PY) tests/demo_animations.py
 
-test: .venv tools fmus
+test: .venv tools browser fmus
 	cargo test --workspace --release --no-fail-fast
 	$(PY) -m pytest tests -q
 

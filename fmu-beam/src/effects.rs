@@ -123,6 +123,7 @@ impl Resolution {
             .decisions
             .iter()
             .any(|d| d.effect == "formulation" && d.setting == "spatial");
+        s += &self.explain_shape(scene, spatial);
         if spatial {
             s += "\ncost: no operation-count model for the 3D element (shares shown as 0); \
                   `make bench` measures the time.\n";
@@ -136,6 +137,65 @@ impl Resolution {
         );
         s
     }
+}
+
+impl Resolution {
+    /// The shape outputs (`crate::shape`): what each beam offers and what reading them costs.
+    fn explain_shape(&self, scene: &Scene, spatial: bool) -> String {
+        let coords = if scene.is_3d() { 3 } else { 2 };
+        let rows: Vec<(String, String, String)> = scene
+            .beams
+            .iter()
+            .zip(&self.effects.beams)
+            .map(|(b, e)| {
+                let n = crate::shape::stations(b, e.rigid).len();
+                let setting = if n == 0 {
+                    "off".to_string()
+                } else {
+                    format!("{n} points, {} outputs", coords * (n + 1))
+                };
+                let cost = if n == 0 {
+                    "none".to_string()
+                } else if spatial {
+                    format!("{} point evaluations per read of all", coords * n)
+                } else {
+                    let total = step_cost(scene, &self.effects);
+                    format!(
+                        "reading all once: {:.2}% of an internal step",
+                        100.0 * shape_read_cost(b, e) / total
+                    )
+                };
+                (format!("shape ({})", b.name), setting, cost)
+            })
+            .collect();
+        if rows.is_empty() {
+            return String::new();
+        }
+        let w = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
+        let ws = rows.iter().map(|r| r.1.len()).max().unwrap_or(0);
+        let mut s = String::from(
+            "\noutputs computed only when read (a step that nobody reads them after costs nothing \
+             more); `shape_points` sets the points, 0 none:\n",
+        );
+        for (name, setting, cost) in rows {
+            s += &format!("{name:<w$}  {setting:<ws$}  {cost}\n");
+        }
+        s
+    }
+}
+
+/// Operations (the unit of [`step_cost`]) to read every shape output of beam `b` once: each
+/// coordinate read evaluates its point, S_p q_f over the frame's n_f coordinates, a rotation
+/// and a translation.
+fn shape_read_cost(b: &BeamSpec, e: &BeamEffects) -> f64 {
+    let nf = if e.rigid {
+        0
+    } else {
+        let nodal = nodal_coordinates(b, Scene::beam_layout(b).0, e.options.axial);
+        e.options.modes.map_or(nodal, |m| m.min(nodal))
+    };
+    let points = crate::shape::stations(b, e.rigid).len() as f64;
+    2.0 * points * (2.0 * nf as f64 + 6.0)
 }
 
 /// First bending natural frequency (rad/s) of a beam alone: clamped–free for a tangent frame,

@@ -38,6 +38,8 @@ struct Model {
     /// System joint index of each scene joint, system body index of each scene body.
     joint_index: Vec<usize>,
     body_index: Vec<usize>,
+    /// The material points of the shape outputs (evaluated only when read).
+    shape: crate::shape::ShapeMaps,
 }
 
 /// The integration state of a built model, as get/set FMU state copy it.
@@ -472,7 +474,9 @@ impl Engine {
                 ),
                 Mechanics::Spatial(_, index) => (index.joints.clone(), index.bodies.clone()),
             };
+            let shape = crate::shape::ShapeMaps::build(&scene, &self.effects, &system);
             self.model = Some(Model {
+                shape,
                 applied_inputs: flat_inputs(&system),
                 stepper: Stepper::new(&system, settings),
                 lands: !system.inputs().is_empty(),
@@ -944,6 +948,14 @@ fn spatial_output(
         K::BodyX(b) => q[body(b)],
         K::BodyY(b) => q[body(b) + 1],
         K::BodyZ(b) => q[body(b) + 2],
+        K::BodyRotation { body: b, row, col } => {
+            let z = sys.body_coords(m.body_index[b], q);
+            crate::multibody3d::body::frame_of(&z).2[(row, col)]
+        }
+        K::JointPosition { joint, axis } => {
+            let f = sys.joints[m.joint_index[joint]].frames[1];
+            sys.frame_pose(f, q).0[axis]
+        }
         K::EnergyKinetic => sys.energy(q, v).kinetic,
         K::EnergyStrain => sys.energy(q, v).strain,
         K::EnergyPotential => sys.energy(q, v).potential,
@@ -971,6 +983,8 @@ fn common_output(m: &Model, kind: OutputKind) -> f64 {
             g.amax()
         }
         K::NextEventTime => crate::interface::next_event_time(&m.system, st.t),
+        K::Shape { beam, point, axis } => m.shape.point(&m.system, &st.q, beam, point)[axis],
+        K::BeamAxis(g, axis) => crate::shape::axis(&m.system, &st.q, g)[axis],
         // no other output is offered by a scene whose system lacks it
         _ => f64::NAN,
     }
@@ -998,6 +1012,16 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
         K::BodyX(b) => q[sys.offsets[m.body_index[b]]],
         K::BodyY(b) => q[sys.offsets[m.body_index[b]] + 1],
         K::BodyPhi(b) => q[sys.offsets[m.body_index[b]] + 2],
+        // a 3D scene run in the plane: a rotation about z
+        K::BodyRotation { body: b, row, col } => {
+            let (s, c) = q[sys.offsets[m.body_index[b]] + 2].sin_cos();
+            [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]][row][col]
+        }
+        K::JointPosition { joint, axis } => {
+            let f = sys.joints[m.joint_index[joint]].frames[1];
+            let p = sys.frame_state(f, q, None).p;
+            [p[0], p[1], 0.0][axis]
+        }
         K::EnergyKinetic => sys.energy(q, v).kinetic,
         K::EnergyStrain => sys.energy(q, v).strain,
         K::EnergyPotential => sys.energy(q, v).potential,

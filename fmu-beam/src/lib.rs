@@ -17,6 +17,7 @@ pub mod modes;
 pub mod multibody;
 pub mod multibody3d;
 pub mod scene;
+pub mod shape;
 pub mod variables;
 
 pub use engine::Engine;

@@ -128,6 +128,29 @@ pub enum OutputKind {
     /// The reaction of a motion drive reading an input (scene joint index), consistent with
     /// the state and the inputs as set now: depends directly on the input's acceleration.
     DriveReaction(usize),
+    /// World coordinate `axis` (0 x, 1 y, 2 z) of shape point `point` (from 0) of scene beam
+    /// `beam` ([`crate::shape`]).
+    Shape {
+        beam: usize,
+        point: usize,
+        axis: usize,
+    },
+    /// World component `axis` of the unit direction the deflections of scene beam `usize` are
+    /// measured from.
+    BeamAxis(usize, usize),
+    /// World coordinate `axis` of the second frame of scene joint `joint` (where a revolute,
+    /// spherical or weld joint is; the sliding frame of a prismatic joint).
+    JointPosition {
+        joint: usize,
+        axis: usize,
+    },
+    /// 3D: entry (row, column) of the rotation matrix of a rigid body (body → world: column j
+    /// is body axis j in world components).
+    BodyRotation {
+        body: usize,
+        row: usize,
+        col: usize,
+    },
     /// Pose of a rigid body (scene body index).
     BodyX(usize),
     BodyY(usize),
@@ -558,6 +581,62 @@ impl VariableTable {
                 );
             }
         }
+        let xyz: &[&str] = if scene.is_3d() {
+            &["x", "y", "z"]
+        } else {
+            &["x", "y"]
+        };
+        for (i, (b, fx)) in scene.beams.iter().zip(&effects.beams).enumerate() {
+            let points = crate::shape::stations(b, fx.rigid).len();
+            if points == 0 {
+                continue;
+            }
+            for (axis, c) in xyz.iter().enumerate() {
+                for point in 0..points {
+                    t.output(
+                        format!("{}.shape.{c}[{}]", b.name, point + 1),
+                        VarType::Real,
+                        Some("m"),
+                        &format!(
+                            "World {c} of point {} of {points} of the deformed centre line, equally \
+                             spaced from flange a to flange b along the undeformed axis",
+                            point + 1
+                        ),
+                        K::Shape {
+                            beam: i,
+                            point,
+                            axis,
+                        },
+                    );
+                }
+            }
+            for (axis, c) in xyz.iter().enumerate() {
+                t.output(
+                    format!("{}.axis.{c}", b.name),
+                    VarType::Real,
+                    None,
+                    &format!(
+                        "World {c} of the unit direction the deflections are measured from (the \
+                         root frame's axis; for a planar pinned frame the chord)"
+                    ),
+                    K::BeamAxis(i, axis),
+                );
+            }
+        }
+        for (i, j) in scene.joints.iter().enumerate() {
+            for (axis, c) in xyz.iter().enumerate() {
+                t.output(
+                    format!("{}.{c}", j.name),
+                    VarType::Real,
+                    Some("m"),
+                    &format!(
+                        "World {c} of the joint's second frame (where a revolute, spherical or \
+                         weld joint is; the sliding frame of a prismatic joint)"
+                    ),
+                    K::JointPosition { joint: i, axis },
+                );
+            }
+        }
         for (i, j) in scene.joints.iter().enumerate() {
             let n = &j.name;
             match j.kind {
@@ -624,6 +703,20 @@ impl VariableTable {
                     "World z of the body frame",
                     K::BodyZ(i),
                 );
+                for row in 0..3 {
+                    for col in 0..3 {
+                        t.output(
+                            format!("{n}.R[{},{}]", row + 1, col + 1),
+                            VarType::Real,
+                            None,
+                            &format!(
+                                "Rotation of the body frame: world {} component of body axis {}",
+                                xyz[row], xyz[col]
+                            ),
+                            K::BodyRotation { body: i, row, col },
+                        );
+                    }
+                }
                 continue;
             }
             t.output(

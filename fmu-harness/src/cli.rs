@@ -1,8 +1,8 @@
 //! The command line: `package`, `explain`, `modes`, `work-precision`, `linear-solvers`,
-//! `simulate` and `cosim`.
+//! `simulate`, `cosim` and `animate`.
 
 use crate::error::HarnessError;
-use crate::{cosim, linear_solvers, modes, package, simulate, work_precision};
+use crate::{animate, cosim, linear_solvers, modes, package, simulate, work_precision};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -73,6 +73,48 @@ pub enum Command {
         /// The CSV file to write [default: standard output, summary on standard error].
         #[arg(short = 'o', long = "csv")]
         csv: Option<PathBuf>,
+    },
+    /// Draw a run as it moved: a self-contained HTML page (time slider, play/pause, speed,
+    /// deformation magnification, a 3D view turned with the mouse) and/or an animated GIF.
+    Animate {
+        /// The run: a CSV of `simulate` or `cosim`, an FMU (run here with its
+        /// DefaultExperiment), or a scene file (run directly by the engine).
+        run: PathBuf,
+        /// The page to write (.html).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// The animated GIF to write.
+        #[arg(long)]
+        gif: Option<PathBuf>,
+        /// The scene whose bodies and joints a CSV holds: a scene file or one of our FMUs;
+        /// `UNIT=FILE` for a cosim unit's outputs (`UNIT.<name>`). Repeatable.
+        #[arg(long)]
+        scene: Vec<String>,
+        /// GIF frames per second of playback.
+        #[arg(long, default_value_t = 25.0)]
+        fps: f64,
+        /// Simulated seconds per second of playback (0.25: four times slower than real time).
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
+        /// Deformation magnification [default: the largest deflection shown as about 10 % of
+        /// its beam's length, at least 1].
+        #[arg(long)]
+        magnify: Option<f64>,
+        /// GIF size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "640x480")]
+        size: String,
+        /// Stop time of a run made here [default: the DefaultExperiment's].
+        #[arg(long)]
+        stop: Option<f64>,
+        /// Communication step of a run made here [default: the DefaultExperiment's].
+        #[arg(long)]
+        step: Option<f64>,
+        /// Write the run made here (FMU or scene) as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Write the GIF's geometry (frame times, magnification, world-to-pixel map) as JSON.
+        #[arg(long)]
+        metadata: Option<PathBuf>,
     },
     /// Work-precision study of the validation cases C1–C4: every formulation (elements,
     /// substructures, rigid parts, modal truncation, stiffening) at every integrator setting
@@ -306,6 +348,114 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 }
             }
         }
+        Command::Animate {
+            run,
+            output,
+            gif,
+            scene,
+            fps,
+            speed,
+            magnify,
+            size,
+            stop,
+            step,
+            csv,
+            metadata,
+        } => {
+            let (width, height) = parse_size(&size)?;
+            let started = std::time::Instant::now();
+            let mut scenes: Vec<animate::KnownScene> = scene
+                .iter()
+                .map(|s| animate::known_scene(s))
+                .collect::<Result<_, _>>()?;
+            let ext = run.extension().and_then(|e| e.to_str()).unwrap_or("");
+            let stem = run
+                .file_stem()
+                .map_or("run".into(), |s| s.to_string_lossy().to_string());
+            let (recording, title) = match ext {
+                "fmu" => {
+                    let (rec, packaged) = animate::run_fmu(&run, stop, step)?;
+                    if let (Some(s), true) = (packaged, scenes.is_empty()) {
+                        scenes.push(animate::KnownScene {
+                            prefix: String::new(),
+                            scene: s,
+                        });
+                    }
+                    (rec, stem)
+                }
+                "toml" => {
+                    let s = fmu_beam::Scene::load(&run)?;
+                    let rec = animate::run_scene(&s, &run.display().to_string(), stop, step)?;
+                    let name = s.name.clone();
+                    if scenes.is_empty() {
+                        scenes.push(animate::KnownScene {
+                            prefix: String::new(),
+                            scene: s,
+                        });
+                    }
+                    (rec, name)
+                }
+                _ => (animate::read_csv(&run)?, stem),
+            };
+            let ran = started.elapsed().as_secs_f64();
+            if let Some(path) = &csv {
+                std::fs::write(path, recording.csv())
+                    .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+            }
+            if output.is_none() && gif.is_none() {
+                return Err(animate::AnimateError::BadOption {
+                    name: "--output/--gif",
+                    value: "none".into(),
+                    rule: "give the page (-o run.html), the GIF (--gif run.gif) or both",
+                }
+                .into());
+            }
+            let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
+            let options = animate::Options {
+                html: output,
+                gif,
+                metadata,
+                fps,
+                speed,
+                magnification: magnify,
+                width,
+                height,
+            };
+            let (m, written) = animate::write(&motion, &options)?;
+            writeln!(
+                out,
+                "{title}: {} recorded times from {} to {} s ({:.2} s to get them); {} beam(s), \
+                 {} bodies, {} joints; deformation x {m} (largest deflection {:.3} % of its \
+                 beam's length)",
+                motion.times.len(),
+                motion.times[0],
+                motion.times[motion.times.len() - 1],
+                ran,
+                motion.beams.len(),
+                motion.bodies.len(),
+                motion.joints.len(),
+                100.0 * motion.largest_deflection_ratio()
+            )
+            .map_err(stdout_err)?;
+            if scenes.is_empty() {
+                writeln!(
+                    out,
+                    "(beams only: give --scene FILE to draw the bodies and joints of a CSV)"
+                )
+                .map_err(stdout_err)?;
+            }
+            for w in written {
+                writeln!(
+                    out,
+                    "wrote {} ({} frames, {:.1} kB, {:.2} s)",
+                    w.path.display(),
+                    w.frames,
+                    w.bytes as f64 / 1024.0,
+                    w.seconds
+                )
+                .map_err(stdout_err)?;
+            }
+        }
         Command::Explain { scene } => {
             let scene = fmu_beam::Scene::load(&scene)?;
             let text = fmu_beam::effects::resolve(&scene).explain(&scene);
@@ -318,4 +468,18 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
         }
     }
     Ok(())
+}
+
+/// `WIDTHxHEIGHT` in pixels.
+fn parse_size(s: &str) -> Result<(u32, u32), HarnessError> {
+    let bad = || animate::AnimateError::BadOption {
+        name: "--size",
+        value: s.to_string(),
+        rule: "WIDTHxHEIGHT in pixels, e.g. 640x480",
+    };
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    Ok((
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    ))
 }

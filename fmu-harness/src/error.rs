@@ -48,6 +48,8 @@ pub enum HarnessError {
     Simulate(#[from] crate::simulate::SimulateError),
     #[error(transparent)]
     Cosim(#[from] crate::cosim::CosimError),
+    #[error(transparent)]
+    Animate(#[from] crate::animate::AnimateError),
     #[error("{origin}: {message}")]
     Input { origin: String, message: String },
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]

@@ -878,6 +878,14 @@ impl System {
     /// Transverse displacement of a world point from the beam's root axis (or, for a pinned
     /// frame, from the chord flange a → flange b).
     pub fn beam_transverse(&self, g: usize, q: &DVector<f64>, p: Vector2<f64>) -> f64 {
+        let (root, axis) = self.beam_axis(g, q);
+        let d = p - root;
+        axis.x * d.y - axis.y * d.x
+    }
+
+    /// The root (flange a) of beam group `g` and the unit world direction its deflections are
+    /// measured from: the root frame's axis, or for a pinned frame the chord to flange b.
+    pub fn beam_axis(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, Vector2<f64>) {
         let grp = &self.beams[g];
         let z0 = self.body_coords(grp.bodies.start, q);
         let root = Vector2::new(z0[0], z0[1]);
@@ -893,8 +901,7 @@ impl System {
             let (s, c) = z0[2].sin_cos();
             Vector2::new(c, s)
         };
-        let d = p - root;
-        axis.x * d.y - axis.y * d.x
+        (root, axis)
     }
 
     /// World position of the beam's mid-span point.

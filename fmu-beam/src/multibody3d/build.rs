@@ -29,6 +29,9 @@ pub struct SceneIndex {
     /// Per scene beam: its root frame (flange a) and tip frame (flange b), frames of the
     /// system whose rotation at t = 0 is the beam's.
     pub beam_frames: Vec<(usize, usize)>,
+    /// Per scene beam: its bodies in the system (substructures from flange a to flange b; one
+    /// rigid body for a rigid bar).
+    pub beam_bodies: Vec<std::ops::Range<usize>>,
     /// System joint index of each scene joint.
     pub joints: Vec<usize>,
     /// System body index of each scene body.
@@ -130,6 +133,7 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
         if fx.rigid {
             let body = sys.add_rigid(rigid_bar(b), at, rot);
             owners.push((b.name.clone(), Owner::Rigid(body), rot));
+            index.beam_bodies.push(body..body + 1);
             continue;
         }
         let g = if let Some(text) = &b.matrix_text {
@@ -152,6 +156,7 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
             )
         };
         owners.push((b.name.clone(), Owner::Beam(g), rot));
+        index.beam_bodies.push(sys.beams[g].bodies.clone());
     }
     for spec in &scene.bodies {
         let rot = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), spec.angle).into_inner();

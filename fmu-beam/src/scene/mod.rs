@@ -232,10 +232,19 @@ pub struct BeamSpec {
     pub matrix_text: Option<String>,
     #[serde(default)]
     pub initial: InitialSpec,
-    /// Outputs to offer; empty means all of [`BEAM_OUTPUTS`].
+    /// Outputs to offer; empty means all of [`BEAM_OUTPUTS`] and the shape (`"shape"`).
     #[serde(default)]
     pub outputs: Vec<String>,
+    /// Points of the deformed centre line offered as `<beam>.shape.x[i]`, `.y[i]` (3D: `.z[i]`),
+    /// equally spaced from flange a to flange b: `None` = the nodes, 0 = no shape outputs
+    /// ([`crate::shape`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_points: Option<usize>,
 }
+
+/// The name in a beam's `outputs` list that offers its shape outputs (the points of its
+/// deformed centre line and the axis its deflections are measured from).
+pub const SHAPE_OUTPUT: &str = "shape";
 
 /// The outputs a beam can offer, by their name after `<beam>.`.
 pub const BEAM_OUTPUTS: [&str; 5] = [

@@ -439,11 +439,23 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<()
         &super::BEAM_OUTPUTS
     };
     for (k, o) in b.outputs.iter().enumerate() {
-        if !outputs.contains(&o.as_str()) {
+        if !outputs.contains(&o.as_str()) && o != super::SHAPE_OUTPUT {
             return Err(ck.fail(
                 &f(&format!("outputs[{k}]")),
                 format!("{o:?}"),
-                &format!("must be one of {outputs:?}"),
+                &format!("must be one of {outputs:?} or {:?}", super::SHAPE_OUTPUT),
+            ));
+        }
+    }
+    if let Some(n) = b.shape_points {
+        if n == 1 || n > crate::shape::MAX_POINTS {
+            return Err(ck.fail(
+                &f("shape_points"),
+                n,
+                &format!(
+                    "must be 0 (no shape outputs) or 2 to {} (points from flange a to flange b)",
+                    crate::shape::MAX_POINTS
+                ),
             ));
         }
     }

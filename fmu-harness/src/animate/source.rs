@@ -1,0 +1,209 @@
+//! Where a run comes from: a CSV of `simulate` or `cosim`, an FMU run here, or a scene run
+//! directly by the engine.
+
+use super::{AnimateError, KnownScene};
+use crate::HarnessError;
+use fmu_beam::variables::{Binding, VarType};
+use fmu_beam::{Engine, Scene};
+use std::io::Read;
+use std::path::Path;
+
+/// Recorded values by column (`time` first).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    pub columns: Vec<String>,
+    /// One vector per column, one value per recorded time.
+    pub values: Vec<Vec<f64>>,
+}
+
+impl Recording {
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.columns.iter().position(|c| c == name)?;
+        Some(self.values[k].clone())
+    }
+
+    /// CSV as `simulate` writes it: a header, then one line per time.
+    pub fn csv(&self) -> String {
+        let mut s = self.columns.join(",");
+        s.push('\n');
+        for r in 0..self.values.first().map_or(0, Vec::len) {
+            let line: Vec<String> = self.values.iter().map(|c| format!("{:e}", c[r])).collect();
+            s.push_str(&line.join(","));
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// A CSV with a header of names (quoted or not) and rows of numbers, such as `simulate`,
+/// `cosim` and fmpy write.
+pub fn read_csv(path: &Path) -> Result<Recording, HarnessError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| HarnessError::io(path, "reading the run's CSV", e))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        return Err(AnimateError::Csv {
+            path: path.into(),
+            message: "empty file".into(),
+        }
+        .into());
+    };
+    let columns: Vec<String> = header
+        .split(',')
+        .map(|c| c.trim().trim_matches('"').to_string())
+        .collect();
+    if columns.first().map(String::as_str) != Some("time") {
+        return Err(AnimateError::Csv {
+            path: path.into(),
+            message: format!("the first column must be `time`, not {:?}", columns.first()),
+        }
+        .into());
+    }
+    let mut values = vec![Vec::new(); columns.len()];
+    for (k, line) in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() != columns.len() {
+            return Err(AnimateError::CsvLine {
+                path: path.into(),
+                line: k + 1,
+                message: format!("{} fields, the header has {}", fields.len(), columns.len()),
+            }
+            .into());
+        }
+        for (c, f) in values.iter_mut().zip(fields) {
+            let v = f.trim().parse::<f64>().map_err(|_| AnimateError::CsvLine {
+                path: path.into(),
+                line: k + 1,
+                message: format!("{f:?} is not a number"),
+            })?;
+            c.push(v);
+        }
+    }
+    Ok(Recording { columns, values })
+}
+
+/// Runs an FMU with the project's master (its DefaultExperiment unless `stop`/`step` say
+/// otherwise), recording every output; with the scene it carries, if it is one of ours.
+pub fn run_fmu(
+    path: &Path,
+    stop: Option<f64>,
+    step: Option<f64>,
+) -> Result<(Recording, Option<Scene>), HarnessError> {
+    let options = crate::simulate::Options {
+        stop_time: stop,
+        step,
+        outputs: Vec::new(),
+    };
+    let r = crate::simulate::simulate(path, &options)?;
+    let mut columns = vec!["time".to_string()];
+    columns.extend(r.columns);
+    let values = (0..columns.len())
+        .map(|k| r.rows.iter().map(|row| row[k]).collect())
+        .collect();
+    Ok((Recording { columns, values }, packaged_scene(path)?))
+}
+
+/// The scene packaged in one of our FMUs (`resources/scene.toml`), `None` for another FMU.
+pub fn packaged_scene(path: &Path) -> Result<Option<Scene>, HarnessError> {
+    let file =
+        std::fs::File::open(path).map_err(|e| HarnessError::io(path, "opening the FMU", e))?;
+    let Ok(mut zip) = zip::ZipArchive::new(file) else {
+        return Ok(None);
+    };
+    let Ok(mut entry) = zip.by_name("resources/scene.toml") else {
+        return Ok(None);
+    };
+    let mut text = String::new();
+    entry
+        .read_to_string(&mut text)
+        .map_err(|e| HarnessError::io(path, "reading resources/scene.toml", e))?;
+    let origin = format!("{}!resources/scene.toml", path.display());
+    Ok(Some(Scene::from_toml_str(&text, &origin)?))
+}
+
+/// Runs a scene directly with the engine, from its experiment's start to `stop` (default
+/// its stop time) with communication step `step` (default its step size), recording every
+/// Real and Integer output at every communication point.
+pub fn run_scene(
+    scene: &Scene,
+    origin: &str,
+    stop: Option<f64>,
+    step: Option<f64>,
+) -> Result<Recording, HarnessError> {
+    let engine_error = |source| HarnessError::Engine {
+        origin: origin.to_string(),
+        source,
+    };
+    let ex = &scene.experiment;
+    let (start, stop, h) = (
+        ex.start_time,
+        stop.unwrap_or(ex.stop_time),
+        step.unwrap_or(ex.step_size),
+    );
+    if !(stop > start && h > 0.0 && h.is_finite()) {
+        return Err(crate::simulate::SimulateError::BadExperiment {
+            start,
+            stop,
+            step: h,
+        }
+        .into());
+    }
+    let mut e = Engine::new(scene.clone());
+    e.set_start_time(start).map_err(engine_error)?;
+    e.exit_initialization().map_err(engine_error)?;
+    let outputs: Vec<(u32, VarType, String)> = e
+        .variables()
+        .variables
+        .iter()
+        .filter(|v| matches!(v.binding, Binding::Output(_)) && v.ty != VarType::Boolean)
+        .filter(|v| v.causality == fmu_beam::variables::Causality::Output)
+        .map(|v| (v.vr, v.ty, v.name.clone()))
+        .collect();
+    let mut columns = vec!["time".to_string()];
+    columns.extend(outputs.iter().map(|o| o.2.clone()));
+    let mut values = vec![Vec::new(); columns.len()];
+    let mut record = |e: &mut Engine, t: f64| -> Result<(), HarnessError> {
+        values[0].push(t);
+        for (k, (vr, ty, _)) in outputs.iter().enumerate() {
+            let v = match ty {
+                VarType::Integer => e.get_integer(*vr).map(f64::from),
+                _ => e.get_real(*vr),
+            }
+            .map_err(engine_error)?;
+            values[k + 1].push(v);
+        }
+        Ok(())
+    };
+    record(&mut e, start)?;
+    let mut t = start;
+    let mut n: u64 = 0;
+    while t < stop - 1e-9 * h {
+        let next = (start + (n + 1) as f64 * h).min(stop);
+        e.do_step(t, next - t).map_err(engine_error)?;
+        t = next;
+        n += 1;
+        record(&mut e, t)?;
+    }
+    Ok(Recording { columns, values })
+}
+
+/// A `--scene [PREFIX=]FILE` argument: a scene file or one of our FMUs.
+pub fn known_scene(arg: &str) -> Result<KnownScene, HarnessError> {
+    let (prefix, file) = match arg.split_once('=') {
+        Some((p, f)) => (format!("{p}."), f),
+        None => (String::new(), arg),
+    };
+    let path = Path::new(file);
+    let scene = if path.extension().is_some_and(|e| e == "fmu") {
+        packaged_scene(path)?.ok_or_else(|| AnimateError::Scene {
+            origin: file.to_string(),
+            message: "the FMU carries no resources/scene.toml (not made by fmu-harness)".into(),
+        })?
+    } else {
+        Scene::load(path)?
+    };
+    Ok(KnownScene { prefix, scene })
+}
