@@ -21,7 +21,8 @@ fn two() -> u8 {
     2
 }
 
-/// A whole scene, as read from its TOML file.
+/// A scene file: the beams, bodies, joints and loads of one FMU, its solver settings, default
+/// experiment and effects.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -107,7 +108,8 @@ pub struct World {
     pub gravity: [f64; 3],
 }
 
-/// Integrator settings; each becomes a tunable FMU parameter `solver.<field>`.
+/// Integrator settings (generalized-α with Newton iterations); each is also a tunable FMU
+/// parameter `solver.<field>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -116,6 +118,7 @@ pub struct SolverSpec {
     #[serde(default = "default_adaptive")]
     pub adaptive: bool,
     /// Relative tolerance of the error control and of the Newton iteration.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
     /// Largest internal step; the fixed step when `adaptive = false`.
@@ -123,6 +126,7 @@ pub struct SolverSpec {
     #[serde(default = "default_max_step")]
     pub max_step: f64,
     /// Spectral radius at infinity of generalized-alpha: 1 = no numerical damping.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_rho_inf")]
     pub rho_inf: f64,
 }
@@ -151,7 +155,7 @@ impl Default for SolverSpec {
     }
 }
 
-/// The DefaultExperiment written into modelDescription.xml.
+/// The DefaultExperiment written into modelDescription.xml (what a master runs by default).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -187,7 +191,8 @@ impl Default for ExperimentSpec {
     }
 }
 
-/// A flexible planar beam (planar paper §3): Euler–Bernoulli elements in one floating frame.
+/// A flexible beam: Euler–Bernoulli finite elements in one floating frame (planar paper §3), or
+/// in substructures; planar, or 3D in a scene with `dimensions = 3`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -325,6 +330,7 @@ pub enum FrameKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
+/// The beam's material (isotropic, linear elastic).
 pub struct MaterialSpec {
     /// Density.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "kg/m^3")))]
@@ -339,8 +345,8 @@ pub struct MaterialSpec {
     pub g: Option<f64>,
 }
 
-/// A cross-section: either `A` and `J` given directly, or a `shape` with its dimensions.
-/// For the planar beam, `a` is the height in the plane of bending, `b` the width.
+/// A cross-section: its constants given directly (planar: `A` and `J`; 3D: `A`, `Iy`, `Iz`,
+/// `It`), or a `shape` with its dimensions (`a`, `b`, `d`, `t`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -386,7 +392,7 @@ pub struct SectionSpec {
     pub t: Option<f64>,
 }
 
-/// Rayleigh damping D = alpha m_ff + beta K_ff.
+/// Rayleigh damping of the deformation, D = alpha M_ff + beta K_ff.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -401,7 +407,7 @@ pub struct RayleighSpec {
     pub beta: f64,
 }
 
-/// Initial deformed state of a beam, at rest.
+/// Initial deformed state of a beam, at rest (planar element, single frame, tangent frame).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
@@ -517,7 +523,7 @@ pub enum DriveKind {
     Effort,
 }
 
-/// A scalar function of time.
+/// A scalar function of time: a drive's law, or a load's scale (`law` and its parameters).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
