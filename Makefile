@@ -14,7 +14,7 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools browser release fmus demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser release fmus docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -51,6 +51,12 @@ fmus: release
 	  $(HARNESS) package "$$s" -o "$$out" --binary $(ENGINE) || { rm -f "$$out"; failed+=("$$s"); }; \
 	done; \
 	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
+
+# The documents generated from the code (issue 16): the scene schema that editors read and the
+# scene reference; fmu-harness/tests/generated_docs.rs fails when the committed ones differ.
+docs: release
+	$(HARNESS) schema -o scenes/scene.schema.json
+	$(HARNESS) reference -o docs/scene-reference.md
 
 # C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus

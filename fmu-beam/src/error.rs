@@ -6,8 +6,9 @@ use thiserror::Error;
 
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EngineError {
+    /// Boxed: a refusal carries four texts, and every step's `Result` would carry their size.
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     #[error("initial state: {message}")]
     InitialState { message: String },
     #[error(
@@ -114,5 +115,11 @@ impl EngineError {
                 | EngineError::Runaway { .. }
                 | EngineError::Stretched { .. }
         )
+    }
+}
+
+impl From<SceneError> for EngineError {
+    fn from(e: SceneError) -> Self {
+        EngineError::Scene(Box::new(e))
     }
 }

@@ -171,6 +171,17 @@ fn mutated_scenes_are_accepted_or_refused_with_the_field_named() {
                 }
                 Err(err) => {
                     refused.set(refused.get() + 1);
+                    // the rule table names every field a rule refuses (the reference lists it)
+                    if let fmu_beam::scene::SceneError::Invalid { code, field, .. } = &err {
+                        let rule = fmu_beam::scene::rules::find(code);
+                        prop_assert!(
+                            rule.is_some_and(|r| r
+                                .fields
+                                .iter()
+                                .any(|p| fmu_beam::scene::rules::field_matches(p, field))),
+                            "rule {code} does not name field {field}: {err}"
+                        );
+                    }
                     let msg = err.to_string();
                     prop_assert!(
                         msg.starts_with(name.as_str()),

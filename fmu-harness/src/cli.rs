@@ -1,8 +1,10 @@
-//! The command line: `package`, `explain`, `modes`, `work-precision`, `linear-solvers`,
-//! `simulate`, `cosim` and `animate`.
+//! The command line: `package`, `explain`, `modes`, `schema`, `reference`, `work-precision`,
+//! `linear-solvers`, `simulate`, `cosim` and `animate`.
 
 use crate::error::HarnessError;
-use crate::{animate, cosim, linear_solvers, modes, package, simulate, work_precision};
+use crate::{
+    animate, cosim, linear_solvers, modes, package, reference, schema, simulate, work_precision,
+};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -45,6 +47,21 @@ pub enum Command {
         /// How many modes to print.
         #[arg(long, default_value_t = 10)]
         count: usize,
+    },
+    /// Write the JSON Schema of scene files (shipped as scenes/scene.schema.json; a scene whose
+    /// first line is `#:schema ./scene.schema.json` is completed and checked by Taplo-based
+    /// editors).
+    Schema {
+        /// The file to write [default: standard output].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Write the scene reference (Markdown: every field of every table, with its type, unit,
+    /// default, allowed values and the validator's rules), shipped as docs/scene-reference.md.
+    Reference {
+        /// The file to write [default: standard output].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
     /// Run one FMI 2.0 co-simulation FMU (any, not only ours) with a fixed communication step
     /// and write the chosen variables at every communication point as CSV (time first).
@@ -461,6 +478,12 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             let text = fmu_beam::effects::resolve(&scene).explain(&scene);
             out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
+        Command::Schema { output } => {
+            write_text(&schema::scene_schema_text(), output.as_deref(), out)?;
+        }
+        Command::Reference { output } => {
+            write_text(&reference::scene_reference(), output.as_deref(), out)?;
+        }
         Command::Modes { scene, count } => {
             let f = modes::elastic_frequencies(&scene)?;
             out.write_all(modes::report(&f, count).as_bytes())
@@ -482,4 +505,19 @@ fn parse_size(s: &str) -> Result<(u32, u32), HarnessError> {
         w.trim().parse().map_err(|_| bad())?,
         h.trim().parse().map_err(|_| bad())?,
     ))
+}
+
+/// Writes generated text to a file, or to `out`.
+fn write_text(
+    text: &str,
+    path: Option<&std::path::Path>,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    match path {
+        Some(p) => std::fs::write(p, text)
+            .map_err(|e| HarnessError::io(p, "writing the generated file", e)),
+        None => out
+            .write_all(text.as_bytes())
+            .map_err(|e| HarnessError::io("<stdout>", "writing the report", e)),
+    }
 }

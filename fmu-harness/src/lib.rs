@@ -19,6 +19,8 @@ pub mod log_categories;
 pub mod model_description;
 pub mod modes;
 pub mod package;
+pub mod reference;
+pub mod schema;
 pub mod simulate;
 pub mod slave;
 pub mod template;

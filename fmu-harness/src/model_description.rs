@@ -126,6 +126,23 @@ fn ordered(table: &VariableTable) -> Vec<&Variable> {
     v
 }
 
+/// A variable's start value as the XML writes it (also in the FMU's documentation).
+pub fn start_text(v: &Variable) -> Option<String> {
+    v.start.map(|s| match v.ty {
+        VarType::Real => format_real(s),
+        VarType::Integer => format!("{}", s.round() as i64),
+        VarType::Boolean => (if s != 0.0 { "true" } else { "false" }).to_string(),
+    })
+}
+
+/// A variable's unit as the XML declares it (Real variables only).
+pub fn unit(v: &Variable) -> Option<&'static str> {
+    match v.ty {
+        VarType::Real => v.unit,
+        _ => None,
+    }
+}
+
 pub fn model_variables(table: &VariableTable) -> Result<String, HarnessError> {
     let mut x = Xml::new();
     x.start("ModelVariables", &[])?;
@@ -142,13 +159,9 @@ pub fn model_variables(table: &VariableTable) -> Result<String, HarnessError> {
             attrs.push(("initial", initial.as_str()));
         }
         x.start("ScalarVariable", &attrs)?;
-        let start = v.start.map(|s| match v.ty {
-            VarType::Real => format_real(s),
-            VarType::Integer => format!("{}", s.round() as i64),
-            VarType::Boolean => (if s != 0.0 { "true" } else { "false" }).to_string(),
-        });
+        let start = start_text(v);
         let mut type_attrs = Vec::new();
-        if let (VarType::Real, Some(unit)) = (v.ty, v.unit) {
+        if let Some(unit) = unit(v) {
             type_attrs.push(("unit", unit));
         }
         if let Some(s) = &start {

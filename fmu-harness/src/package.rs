@@ -35,7 +35,8 @@ pub struct FmuContents {
     pub guid: String,
     pub model_description: String,
     pub scene_text: String,
-    /// documentation/index.html: the resolved effects and why (`fmu-harness explain`).
+    /// documentation/index.html: the variables (from the same table as the XML), the resolved
+    /// effects and why (`fmu-harness explain`), the direct feedthrough.
     pub documentation: String,
     pub variables: usize,
 }
@@ -52,32 +53,75 @@ pub fn contents(scene: &Scene, binary: &[u8]) -> Result<FmuContents, HarnessErro
         guid,
         model_description,
         scene_text,
-        documentation: documentation(scene),
+        documentation: documentation(scene, &table),
         variables: table.variables.len(),
     })
 }
 
-/// documentation/index.html: the scene's description, its resolved effects and its direct
+/// documentation/index.html: the scene's description, its variables (the table that
+/// modelDescription.xml is written from: name, causality, variability, type, unit, start,
+/// meaning; inputs first, then outputs, then parameters), its resolved effects and its direct
 /// feedthrough (`fmu_beam::interface::explain`).
-fn documentation(scene: &Scene) -> String {
-    let escape = |s: &str| {
-        s.replace('&', "&amp;")
-            .replace('<', "&lt;")
-            .replace('>', "&gt;")
-    };
+fn documentation(scene: &Scene, table: &VariableTable) -> String {
     let effects = fmu_beam::effects::resolve(scene).explain(scene);
-    let feedthrough =
-        fmu_beam::interface::explain(scene, &fmu_beam::variables::VariableTable::build(scene));
+    let feedthrough = fmu_beam::interface::explain(scene, table);
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head>\n\
-         <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Effects</h2>\n<pre>\n{effects}</pre>\n\
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\n{STYLE}</head>\n\
+         <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Variables</h2>\n{variables}\
+         <h2>Effects</h2>\n<pre>\n{effects}</pre>\n\
          <h2>Direct feedthrough and directional derivatives</h2>\n<pre>\n{feedthrough}</pre>\n\
          </body></html>\n",
         name = escape(&scene.name),
         description = escape(&scene.description),
+        variables = variables_html(table),
         effects = escape(&effects),
         feedthrough = escape(&feedthrough),
     )
+}
+
+const STYLE: &str = "<style>table{border-collapse:collapse}td,th{border:1px solid #ccc;\
+                     padding:2px 6px;text-align:left}td.num{text-align:right}</style>";
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The variables as an HTML table, one row per variable: what a master's user connects
+/// (inputs, outputs) first, then what they may set (parameters).
+fn variables_html(table: &VariableTable) -> String {
+    use fmu_beam::variables::Causality;
+    let mut html = String::from(
+        "<p>Units are SI. An input is held over a communication step (or extrapolated from the \
+         derivatives a master sets); a tunable parameter may be set between steps, a fixed one \
+         only before initialization.</p>\n<table id=\"variables\">\n<tr><th>name</th>\
+         <th>causality</th><th>variability</th><th>type</th><th>unit</th><th>start</th>\
+         <th>valueReference</th><th>meaning</th></tr>\n",
+    );
+    let rank = |c: Causality| match c {
+        Causality::Input => 0,
+        Causality::Output => 1,
+        Causality::Parameter | Causality::CalculatedParameter => 2,
+    };
+    let mut rows: Vec<_> = table.variables.iter().collect();
+    rows.sort_by_key(|v| (rank(v.causality), v.vr));
+    for v in rows {
+        html.push_str(&format!(
+            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            escape(&v.name),
+            v.causality.as_str(),
+            v.variability.as_str(),
+            v.ty.as_str(),
+            escape(model_description::unit(v).unwrap_or("")),
+            model_description::start_text(v).unwrap_or_default(),
+            v.vr,
+            escape(&v.description),
+        ));
+    }
+    html.push_str("</table>\n");
+    html
 }
 
 /// The scene text the engine will read, checked to read back as the same scene.

@@ -5,6 +5,7 @@
 //! checked in [`validate`], whose errors name the field and the rule.
 
 mod planar;
+pub mod rules;
 mod space;
 mod validate;
 pub mod xyz;
@@ -20,12 +21,15 @@ fn two() -> u8 {
     2
 }
 
-/// A whole scene, as read from its TOML file.
+/// A scene file: the beams, bodies, joints and loads of one FMU, its solver settings, default
+/// experiment and effects.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
-    /// Model name; the packager derives the modelIdentifier from it.
+    /// Model name: the FMU's modelName and modelIdentifier.
     pub name: String,
+    /// Free text: the FMU's description and the first line of its documentation.
     #[serde(default)]
     pub description: String,
     /// 2 (default): a planar scene in the world x–y plane; 3: a spatial scene (3D beams,
@@ -33,32 +37,41 @@ pub struct Scene {
     #[serde(default = "two")]
     pub dimensions: u8,
     /// Which beam element a 3D scene runs with: `auto` (the planar element when the scene's
-    /// motion stays in the world x–y plane, [`Scene::planar_reduction`]) or `spatial` (always
-    /// the 3D element).
+    /// motion stays in the world x–y plane: exact, and faster) or `spatial` (always the 3D
+    /// element).
     #[serde(default)]
     pub formulation: Formulation,
+    /// The gravity field.
     #[serde(default)]
     pub world: World,
+    /// Integrator settings.
     #[serde(default)]
     pub solver: SolverSpec,
+    /// The FMU's DefaultExperiment.
     #[serde(default)]
     pub experiment: ExperimentSpec,
+    /// The flexible beams (at least one).
     #[serde(default, rename = "beam")]
     pub beams: Vec<BeamSpec>,
+    /// The rigid bodies.
     #[serde(default, rename = "body")]
     pub bodies: Vec<RigidBodySpec>,
+    /// The joints between frames, with their drives.
     #[serde(default, rename = "joint")]
     pub joints: Vec<JointSpec>,
+    /// Point forces and torques on frames.
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadSpec>,
-    /// What to simulate: `"all"` (default), `"auto"`, or a list of effect names
-    /// (`crate::effects::EFFECTS`).
+    /// What to simulate: `"all"` (default: the full model), `"auto"` (the generator decides
+    /// from the scene, `fmu-harness explain` says why), or a list of effect names: gravity,
+    /// flexibility, axial, quadratic_velocity, geometric_stiffening, rayleigh_damping.
     #[serde(default)]
     pub effects: EffectsSpec,
 }
 
 /// The scene's `effects`: a mode (`"all"`, `"auto"`) or the list of effects to simulate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(untagged)]
 pub enum EffectsSpec {
     Mode(String),
@@ -73,6 +86,7 @@ impl Default for EffectsSpec {
 
 /// Which element a 3D scene runs with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum Formulation {
     /// The planar element when the motion is planar, else the spatial one.
@@ -82,28 +96,37 @@ pub enum Formulation {
     Spatial,
 }
 
-/// The world: its gravity field (m/s^2, world axes; `[gx, gy]` or `[gx, gy, gz]`).
+/// The world: its gravity field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct World {
+    /// Gravity (world axes): `[gx, gy]` or `[gx, gy, gz]`; no field, no gravity terms.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m/s^2")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
     pub gravity: [f64; 3],
 }
 
-/// Integrator settings; each becomes a tunable FMU parameter `solver.<field>`.
+/// Integrator settings (generalized-α with Newton iterations); each is also a tunable FMU
+/// parameter `solver.<field>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     /// Local error control on (true) or a fixed internal step of `max_step` (false).
     #[serde(default = "default_adaptive")]
     pub adaptive: bool,
     /// Relative tolerance of the error control and of the Newton iteration.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
-    /// Largest internal step (s); the fixed step when `adaptive = false`.
+    /// Largest internal step; the fixed step when `adaptive = false`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default = "default_max_step")]
     pub max_step: f64,
     /// Spectral radius at infinity of generalized-alpha: 1 = no numerical damping.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_rho_inf")]
     pub rho_inf: f64,
 }
@@ -132,15 +155,21 @@ impl Default for SolverSpec {
     }
 }
 
-/// The DefaultExperiment written into modelDescription.xml.
+/// The DefaultExperiment written into modelDescription.xml (what a master runs by default).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ExperimentSpec {
+    /// Start time.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default)]
     pub start_time: f64,
+    /// Stop time.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default = "default_stop_time")]
     pub stop_time: f64,
-    /// Communication step (s).
+    /// Communication step (a suggestion: the master chooses its own).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default = "default_step_size")]
     pub step_size: f64,
 }
@@ -162,17 +191,23 @@ impl Default for ExperimentSpec {
     }
 }
 
-/// A flexible planar beam (planar paper §3): Euler–Bernoulli elements in one floating frame.
+/// A flexible beam: Euler–Bernoulli finite elements in one floating frame (planar paper §3), or
+/// in substructures; planar, or 3D in a scene with `dimensions = 3`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct BeamSpec {
+    /// Beam name: the prefix of its variables (`<beam>.tip.x`) and of its frames `<beam>.a`
+    /// (root flange) and `<beam>.b` (tip flange).
     pub name: String,
-    /// Undeformed length (m).
+    /// Undeformed length.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     pub length: f64,
     /// Number of finite elements N of a single-frame beam.
     #[serde(default)]
     pub elements: Option<usize>,
-    /// Number of substructures k (planar paper §3.4): k floating frames welded tip to root.
+    /// Number of substructures k (planar paper §3.4): k floating frames welded tip to root,
+    /// for large deformation.
     #[serde(default)]
     pub substructures: Option<usize>,
     /// Elements in each substructure (with `substructures`).
@@ -187,23 +222,31 @@ pub struct BeamSpec {
     /// Modal truncation: keep the lowest `modes` modes of each frame's deformation.
     #[serde(default)]
     pub modes: Option<usize>,
-    /// Reference frame of the deformation field (planar paper §3.3).
+    /// Reference frame of the deformation field (planar paper §3.3): `tangent` at flange a,
+    /// or `pinned` through both ends.
     #[serde(default)]
     pub frame: FrameKind,
+    /// The material.
     pub material: MaterialSpec,
-    /// Required, except for a beam from a matrix file.
+    /// The cross-section: constants given directly, or a shape with its dimensions. Required,
+    /// except for a beam from a matrix file.
     #[serde(default)]
     pub section: SectionSpec,
+    /// Rayleigh damping of the deformation.
     #[serde(default)]
     pub rayleigh: RayleighSpec,
-    /// World position of flange a (m) in the undeformed initial configuration.
+    /// World position of flange a in the undeformed initial configuration.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
     pub position: [f64; 3],
-    /// World angle of the beam axis (rad) in the initial configuration (planar scenes, and
+    /// World angle of the beam axis about z in the initial configuration (planar scenes, and
     /// the default axis of a 3D beam: in the x–y plane).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "rad")))]
     #[serde(default)]
     pub angle: f64,
     /// 3D: world direction of the beam axis (local x) at t = 0 (default: from `angle`).
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::direction"))]
     #[serde(
         default,
         with = "xyz::direction",
@@ -212,6 +255,7 @@ pub struct BeamSpec {
     pub axis: Option<[f64; 3]>,
     /// 3D: world direction of the section's local z axis at t = 0, normal to `axis`
     /// (default: world z). Bending in the local x–y plane uses `Iz`, in x–z `Iy`.
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::direction"))]
     #[serde(
         default,
         with = "xyz::direction",
@@ -222,22 +266,25 @@ pub struct BeamSpec {
     /// quadratic-velocity update; the fast variant).
     #[serde(default)]
     pub inertia: InertiaSpec,
-    /// 3D: a one-element beam whose 12 × 12 mass and stiffness come from this file
-    /// (`crate::beam::matrix_file` documents the format), relative to the scene file.
-    /// [`Scene::load`] reads it into `matrix_text`, which the FMU carries.
+    /// 3D: a one-element beam whose 12 × 12 mass and stiffness come from this file, relative
+    /// to the scene file (format: `fmu-beam/src/beam/matrix_file.rs`); the FMU carries its text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_file: Option<String>,
     /// The matrix file's text (filled by [`Scene::load`]; written into the packaged scene).
+    #[cfg_attr(feature = "schema", schemars(skip))]
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_text: Option<String>,
+    /// The initial deformed state.
     #[serde(default)]
     pub initial: InitialSpec,
-    /// Outputs to offer; empty means all of [`BEAM_OUTPUTS`] and the shape (`"shape"`).
+    /// The outputs to offer, by their name after `<beam>.` (empty: all, and the shape). Planar:
+    /// tip.deflection, tip.x, tip.y, tip.phi, mid.deflection; 3D: tip.x, tip.y, tip.z,
+    /// tip.deflection_y, tip.deflection_z, tip.twist; both: shape (`<beam>.shape.*`, `.axis.*`).
     #[serde(default)]
     pub outputs: Vec<String>,
     /// Points of the deformed centre line offered as `<beam>.shape.x[i]`, `.y[i]` (3D: `.z[i]`),
-    /// equally spaced from flange a to flange b: `None` = the nodes, 0 = no shape outputs
-    /// ([`crate::shape`]).
+    /// equally spaced from flange a to flange b; absent: at the nodes; 0: no shape outputs
+    /// (`crate::shape`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_points: Option<usize>,
 }
@@ -265,17 +312,42 @@ pub const BEAM_OUTPUTS_3D: [&str; 6] = [
     "tip.twist",
 ];
 
+/// The names a planar beam's `outputs` list may hold: [`BEAM_OUTPUTS`] and [`SHAPE_OUTPUT`].
+pub const BEAM_OUTPUT_NAMES: [&str; 6] = [
+    "tip.deflection",
+    "tip.x",
+    "tip.y",
+    "tip.phi",
+    "mid.deflection",
+    SHAPE_OUTPUT,
+];
+
+/// The names a 3D beam's `outputs` list may hold: [`BEAM_OUTPUTS_3D`] and [`SHAPE_OUTPUT`].
+pub const BEAM_OUTPUT_NAMES_3D: [&str; 7] = [
+    "tip.x",
+    "tip.y",
+    "tip.z",
+    "tip.deflection_y",
+    "tip.deflection_z",
+    "tip.twist",
+    SHAPE_OUTPUT,
+];
+
 /// Inertia model of a 3D beam.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum InertiaSpec {
+    /// The full inertia of the 3D paper.
     #[default]
     Full,
+    /// Constant mass matrix, no quadratic-velocity update (3D paper §6).
     Frozen,
 }
 
 /// Reference frame conventions of the planar paper §3.3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum FrameKind {
     /// Frame tangent to the beam at flange a: root deformation (u, v, slope) is zero.
@@ -286,120 +358,166 @@ pub enum FrameKind {
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
+/// The beam's material (isotropic, linear elastic).
 pub struct MaterialSpec {
-    /// Density (kg/m^3).
+    /// Density.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "kg/m^3")))]
     pub rho: f64,
-    /// Young's modulus (Pa).
+    /// Young's modulus.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "Pa")))]
     #[serde(rename = "E")]
     pub e: f64,
-    /// Shear modulus (Pa); used by 3D beams only.
+    /// Shear modulus (torsion); used by 3D beams only, required by a flexible one.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "Pa")))]
     #[serde(rename = "G", default)]
     pub g: Option<f64>,
 }
 
-/// A cross-section: either `A` and `J` given directly, or a `shape` with its dimensions.
-/// For the planar beam, `a` is the height in the plane of bending, `b` the width.
+/// A cross-section: its constants given directly (planar: `A` and `J`; 3D: `A`, `Iy`, `Iz`,
+/// `It`), or a `shape` with its dimensions (`a`, `b`, `d`, `t`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SectionSpec {
-    /// Area (m^2), given directly.
+    /// Area, given directly.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m^2")))]
     #[serde(rename = "A", default)]
     pub area: Option<f64>,
-    /// Second moment of area for in-plane bending (m^4), given directly (planar scenes).
+    /// Second moment of area for in-plane bending, given directly (planar scenes).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m^4")))]
     #[serde(rename = "J", default, skip_serializing_if = "Option::is_none")]
     pub second_moment: Option<f64>,
-    /// 3D, given directly: second moments I_y = ∫z² dA (bending in x–z) and I_z = ∫y² dA
-    /// (bending in x–y), and the Saint-Venant torsion constant (m^4).
+    /// 3D, given directly: second moment I_y = ∫z² dA (bending in the local x–z plane).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m^4")))]
     #[serde(rename = "Iy", default, skip_serializing_if = "Option::is_none")]
     pub iy: Option<f64>,
+    /// 3D, given directly: second moment I_z = ∫y² dA (bending in the local x–y plane).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m^4")))]
     #[serde(rename = "Iz", default, skip_serializing_if = "Option::is_none")]
     pub iz: Option<f64>,
+    /// 3D, given directly: Saint-Venant torsion constant.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m^4")))]
     #[serde(rename = "It", default, skip_serializing_if = "Option::is_none")]
     pub torsion_constant: Option<f64>,
     /// `rectangle`, `circle`, `hollow_rectangle`, `hollow_circle`.
     #[serde(default)]
     pub shape: Option<String>,
+    /// Height of a rectangle (in the plane of bending; 3D: along the local y axis).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     #[serde(default)]
     pub a: Option<f64>,
+    /// Width of a rectangle (3D: along the local z axis).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     #[serde(default)]
     pub b: Option<f64>,
+    /// Outer diameter of a circle.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     #[serde(default)]
     pub d: Option<f64>,
-    /// Wall thickness of a hollow shape (m).
+    /// Wall thickness of a hollow shape.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     #[serde(default)]
     pub t: Option<f64>,
 }
 
-/// Rayleigh damping D = alpha m_ff + beta K_ff.
+/// Rayleigh damping of the deformation, D = alpha M_ff + beta K_ff.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RayleighSpec {
+    /// Mass-proportional coefficient.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1/s")))]
     #[serde(default)]
     pub alpha: f64,
+    /// Stiffness-proportional coefficient.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default)]
     pub beta: f64,
 }
 
-/// Initial deformed state of a beam, at rest.
+/// Initial deformed state of a beam, at rest (planar element, single frame, tangent frame).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// Transverse tip displacement (m) of the static shape under a tip force (tangent frame).
+    /// Transverse tip displacement of the static shape under a tip force (tangent frame).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
     #[serde(default)]
     pub tip_displacement: f64,
 }
 
 /// A rigid body (planar, or 3D with its frame parallel to the world's at t = 0).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RigidBodySpec {
+    /// Body name: the prefix of its variables (`<body>.x`) and frames (`<body>.origin`).
     pub name: String,
-    /// Mass (kg); zero is allowed when joints fix every coordinate of the body.
+    /// Mass; zero is allowed when joints fix every coordinate of the body.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "kg")))]
     pub mass: f64,
-    /// Moment of inertia about the centre of mass (kg m^2): a number (about z) or, in 3D,
-    /// the principal moments `[Ixx, Iyy, Izz]` along the body axes.
+    /// Moment of inertia about the centre of mass: a number (about z) or, in 3D, the
+    /// principal moments `[Ixx, Iyy, Izz]` along the body axes.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "kg m^2")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::about_z"))]
     #[serde(default, with = "xyz::about_z")]
     pub inertia: [f64; 3],
-    /// Centre of mass in the body frame (m).
+    /// Centre of mass in the body frame.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
     pub com: [f64; 3],
-    /// World position (m) and angle (rad, about z) of the body frame at t = 0.
+    /// World position of the body frame at t = 0.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
     pub position: [f64; 3],
+    /// World angle of the body frame about z at t = 0.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "rad")))]
     #[serde(default)]
     pub angle: f64,
-    /// Named frames (positions in the body frame); `origin` and `com` always exist.
+    /// Named frames: `name = [x, y]` or `[x, y, z]`, positions in the body frame (m), joined
+    /// or loaded as `<body>.<name>`; `origin` and `com` always exist.
     #[serde(default)]
     pub frames: std::collections::BTreeMap<String, Point>,
 }
 
 /// A joint between two frames: `world`, `<beam>.a`, `<beam>.b`, `<body>.<frame>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct JointSpec {
+    /// Joint name: the prefix of its variables (`<joint>.angle`, `<joint>.drive.torque`).
     pub name: String,
+    /// The kind of joint.
     #[serde(rename = "type")]
     pub kind: JointKind,
-    /// The two frames the joint connects; a prismatic joint slides along the x axis of the
-    /// first, turned by `axis_angle`.
+    /// The two frames the joint connects: `world`, `<beam>.a`, `<beam>.b`, `<body>.<frame>`;
+    /// a prismatic joint slides along the x axis of the first, turned by `axis_angle`.
     pub frames: [String; 2],
+    /// Planar prismatic joint: angle of the sliding axis from the first frame's x axis.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "rad")))]
     #[serde(default)]
     pub axis_angle: f64,
     /// 3D: world direction, at t = 0, of a revolute joint's rotation axis or a prismatic
     /// joint's sliding axis (default: world z for a revolute joint, the first frame's x axis
     /// turned by `axis_angle` about z for a prismatic one).
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::direction"))]
     #[serde(
         default,
         with = "xyz::direction",
         skip_serializing_if = "Option::is_none"
     )]
     pub axis: Option<[f64; 3]>,
+    /// A drive of the joint's coordinate (revolute and prismatic joints).
     #[serde(default)]
     pub drive: Option<DriveSpec>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum JointKind {
     /// Rigid connection: position and angle of the two frames coincide.
@@ -414,54 +532,78 @@ pub enum JointKind {
 
 /// What drives a revolute or prismatic joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct DriveSpec {
     /// `motion` (the joint coordinate follows the law), or `effort` (a torque, or a force for a
-    /// prismatic joint, acts across the joint).
+    /// prismatic joint, acts across the joint). A motion drive's law gives the coordinate
+    /// (rad or m), an effort drive's the torque (N m) or force (N).
     pub kind: DriveKind,
     #[serde(flatten)]
     pub law: LawSpec,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum DriveKind {
+    /// The joint coordinate follows the law.
     Motion,
+    /// A torque or force acts across the joint.
     Effort,
 }
 
-/// A scalar function of time.
+/// A scalar function of time: a drive's law, or a load's scale (`law` and its parameters).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct LawSpec {
     /// `constant`, `exponential` (value (1 - exp(-t/time_constant))), `spin_up` (planar paper
     /// eq. (18) with `omega` and `ramp_time`), `table` (piecewise linear), `input` (an FMU input).
     pub law: String,
+    /// The value of `constant`, the final value of `exponential`, the start value of `input`
+    /// (unit of what the law drives: rad or m, N m or N; a load's scale is a factor).
     #[serde(default)]
     pub value: Option<f64>,
+    /// Time constant of `exponential`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default)]
     pub time_constant: Option<f64>,
-    /// The law is zero after this time (s).
+    /// The law is zero after this time.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default)]
     pub until: Option<f64>,
+    /// Final angular speed of `spin_up` (a motion drive of a revolute joint).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "rad/s")))]
     #[serde(default)]
     pub omega: Option<f64>,
+    /// Duration of the `spin_up` ramp.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "s")))]
     #[serde(default)]
     pub ramp_time: Option<f64>,
-    /// Rows [t, value], t increasing.
+    /// Rows [t, value] of `table` (t in s, increasing), interpolated linearly and held after
+    /// the last row.
     #[serde(default)]
     pub table: Option<Vec<[f64; 2]>>,
 }
 
 /// A point force (world axes) and torque on a frame, constant or FMU inputs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
+    /// Load name: the prefix of its inputs and outputs (`<load>.fx`, `<load>.ax`).
     pub name: String,
+    /// The frame it acts on: `<beam>.a`, `<beam>.b` or `<body>.<frame>`.
     pub frame: String,
+    /// Force (world axes): `[fx, fy]` or `[fx, fy, fz]`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "N")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
     pub force: [f64; 3],
-    /// A number (about z) or, in 3D, `[tx, ty, tz]` (world axes).
+    /// Torque: a number (about z) or, in 3D, `[tx, ty, tz]` (world axes).
+    #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "N m")))]
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::about_z"))]
     #[serde(default, with = "xyz::about_z")]
     pub torque: [f64; 3],
     /// Offer `<load>.fx`, `<load>.fy`, `<load>.torque` (3D: `.fz`, `.tx`, `.ty`, `.tz`) as FMU
@@ -475,8 +617,13 @@ pub struct LoadSpec {
 
 /// A point in a body frame: `[x, y]` or `[x, y, z]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(transparent)]
-pub struct Point(#[serde(with = "xyz::point")] pub [f64; 3]);
+pub struct Point(
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
+    #[serde(with = "xyz::point")]
+    pub [f64; 3],
+);
 
 impl Scene {
     /// Parses and validates scene text; `origin` (a file name) prefixes every message.

@@ -4,6 +4,7 @@
 //! (then it runs with the planar element, [`Scene::planar_reduction`]).
 
 use super::planar::unit;
+use super::rules::{self as r, Rule};
 use super::validate::{Checker, SceneError};
 use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
 use crate::beam::matrix_file;
@@ -20,36 +21,39 @@ pub(super) fn validate_space(ck: &Checker, s: &Scene) -> Result<(), SceneError> 
 }
 
 fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
-    const PLANE: &str = "a planar scene lies in the world x–y plane (z = 0); \
-                         write dimensions = 3 for a 3D scene";
-    const ONLY_3D: &str = "is for 3D scenes (dimensions = 3)";
-    let zero = |field: &str, v: f64, rule: &str| {
+    let zero = |field: &str, v: f64, rule: &Rule| {
         if v == 0.0 {
             Ok(())
         } else {
-            Err(ck.fail(field, v, rule))
+            Err(ck.fail(rule, field, v))
         }
     };
-    let none = |field: &str, v: bool| {
+    let none = |field: &str, v: bool, rule: &Rule| {
         if v {
-            Err(ck.fail(field, "given", ONLY_3D))
+            Err(ck.fail(rule, field, "given"))
         } else {
             Ok(())
         }
     };
+    const PLANE: &Rule = &r::IN_PLANE;
     if s.formulation != Formulation::Auto {
-        return Err(ck.fail("formulation", "\"spatial\"", ONLY_3D));
+        return Err(ck.fail(&r::SPATIAL_FORMULATION, "formulation", "\"spatial\""));
     }
     zero("world.gravity[2]", s.world.gravity[2], PLANE)?;
     for (i, b) in s.beams.iter().enumerate() {
         let f = |n: &str| format!("beam[{i}].{n}");
         zero(&f("position[2]"), b.position[2], PLANE)?;
-        none(&f("axis"), b.axis.is_some())?;
-        none(&f("normal"), b.normal.is_some())?;
-        none(&f("inertia"), b.inertia != InertiaSpec::Full)?;
+        none(&f("axis"), b.axis.is_some(), &r::ONLY_3D_FIELD)?;
+        none(&f("normal"), b.normal.is_some(), &r::ONLY_3D_FIELD)?;
+        none(
+            &f("inertia"),
+            b.inertia != InertiaSpec::Full,
+            &r::FROZEN_INERTIA,
+        )?;
         none(
             &f("matrix_file"),
             b.matrix_file.is_some() || b.matrix_text.is_some(),
+            &r::ONLY_3D_FIELD,
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
@@ -63,26 +67,22 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
             zero(
                 &f(&format!("inertia[{k}]")),
                 b.inertia[k],
-                "a planar body has one moment of inertia (about z): give a number",
+                &r::PLANAR_INERTIA,
             )?;
         }
     }
     for (i, j) in s.joints.iter().enumerate() {
         let f = |n: &str| format!("joint[{i}].{n}");
-        none(&f("axis"), j.axis.is_some())?;
+        none(&f("axis"), j.axis.is_some(), &r::ONLY_3D_FIELD)?;
         if j.kind == JointKind::Spherical {
-            return Err(ck.fail(&f("type"), "\"spherical\"", ONLY_3D));
+            return Err(ck.fail(&r::SPHERICAL, &f("type"), "\"spherical\""));
         }
     }
     for (i, l) in s.loads.iter().enumerate() {
         let f = |n: &str| format!("load[{i}].{n}");
         zero(&f("force[2]"), l.force[2], PLANE)?;
         for k in 0..2 {
-            zero(
-                &f(&format!("torque[{k}]")),
-                l.torque[k],
-                "a planar torque acts about z: give a number",
-            )?;
+            zero(&f(&format!("torque[{k}]")), l.torque[k], &r::PLANAR_TORQUE)?;
         }
     }
     Ok(())
@@ -93,22 +93,17 @@ fn direction(ck: &Checker, field: &str, v: [f64; 3]) -> Result<[f64; 3], SceneEr
     for (k, x) in v.iter().enumerate() {
         ck.finite(&format!("{field}[{k}]"), *x)?;
     }
-    unit(v).ok_or_else(|| ck.fail(field, format!("{v:?}"), "must be a non-zero direction"))
+    unit(v).ok_or_else(|| ck.fail(&r::DIRECTION, field, format!("{v:?}")))
 }
 
 fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     // why the planar element cannot be used, if it cannot
     let spatial = s.planar_reduction().err();
-    let planar_only = |field: &str, value: String, what: &str| -> Result<(), SceneError> {
+    let planar_only = |field: &str, value: String| -> Result<(), SceneError> {
         match &spatial {
-            Some(why) => Err(ck.fail(
-                field,
-                value,
-                &format!(
-                    "{what} is available with the planar element only, and this scene runs \
-                     with the 3D element ({why})"
-                ),
-            )),
+            Some(why) => {
+                Err(ck.fail_with(&r::PLANAR_ELEMENT_ONLY, field, value, &format!(" ({why})")))
+            }
             None => Ok(()),
         }
     };
@@ -122,41 +117,24 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
             let n = direction(ck, &f("normal"), n)?;
             let dot = axis[0] * n[0] + axis[1] * n[1] + axis[2] * n[2];
             if dot.abs() > 1e-9 {
-                return Err(ck.fail(
-                    &f("normal"),
-                    format!("{n:?}"),
-                    "must be normal to the beam axis (it is the section's local z axis)",
-                ));
+                return Err(ck.fail(&r::NORMAL_TO_AXIS, &f("normal"), format!("{n:?}")));
             }
         } else if axis[2].abs() > 1e-9 {
-            return Err(ck.fail(
-                &f("normal"),
-                "missing",
-                "is required when the beam axis leaves the x–y plane (the default is world z)",
-            ));
+            return Err(ck.fail(&r::NORMAL_REQUIRED, &f("normal"), "missing"));
         }
         if !b.rigid && b.matrix_text.is_none() && b.material.g.is_none() {
-            return Err(ck.fail(
-                &f("material.G"),
-                "missing",
-                "a flexible 3D beam needs its shear modulus (torsion)",
-            ));
+            return Err(ck.fail(&r::SHEAR_MODULUS, &f("material.G"), "missing"));
         }
         if b.modes.is_some() {
-            planar_only(&f("modes"), format!("{:?}", b.modes), "modal truncation")?;
+            planar_only(&f("modes"), format!("{:?}", b.modes))?;
         }
         if b.geometric_stiffening {
-            planar_only(
-                &f("geometric_stiffening"),
-                "true".into(),
-                "geometric stiffening",
-            )?;
+            planar_only(&f("geometric_stiffening"), "true".into())?;
         }
         if b.initial.tip_displacement != 0.0 {
             planar_only(
                 &f("initial.tip_displacement"),
                 b.initial.tip_displacement.to_string(),
-                "an initial static deflection",
             )?;
         }
         if let Some(text) = &b.matrix_text {
@@ -164,21 +142,27 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
                 .matrix_file
                 .clone()
                 .unwrap_or_else(|| "matrix_text".into());
-            let m = matrix_file::parse(text, &file)
-                .map_err(|e| ck.fail(&f("matrix_file"), format!("{file:?}"), &e.to_string()))?;
-            if b.rigid || b.elements != Some(1) {
-                return Err(ck.fail(
+            let m = matrix_file::parse(text, &file).map_err(|e| {
+                ck.fail_with(
+                    &r::MATRIX_FILE,
                     &f("matrix_file"),
                     format!("{file:?}"),
-                    "a matrix-file beam is one flexible element: write elements = 1, no \
-                     substructures, not rigid",
+                    &format!(": {e}"),
+                )
+            })?;
+            if b.rigid || b.elements != Some(1) {
+                return Err(ck.fail(
+                    &r::MATRIX_ONE_ELEMENT,
+                    &f("matrix_file"),
+                    format!("{file:?}"),
                 ));
             }
             if (m.length - b.length).abs() > 1e-9 * b.length {
-                return Err(ck.fail(
+                return Err(ck.fail_with(
+                    &r::MATRIX_LENGTH,
                     &f("length"),
                     b.length,
-                    &format!("must equal the matrix file's length {}", m.length),
+                    &format!(" {}", m.length),
                 ));
             }
         }
@@ -189,23 +173,17 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
             direction(ck, &f("axis"), a)?;
         }
         if j.kind == JointKind::Spherical && j.drive.is_some() {
-            return Err(ck.fail(
-                &f("drive"),
-                "given",
-                "a spherical joint has no single coordinate to drive",
-            ));
+            return Err(ck.fail(&r::SPHERICAL_NO_DRIVE, &f("drive"), "given"));
         }
     }
     if let (Some(why), EffectsSpec::List(names)) = (&spatial, &s.effects) {
         for (k, n) in names.iter().enumerate() {
             if !SPATIAL_EFFECTS.contains(&n.as_str()) {
-                return Err(ck.fail(
+                return Err(ck.fail_with(
+                    &r::SPATIAL_EFFECTS,
                     &format!("effects[{k}]"),
                     format!("{n:?}"),
-                    &format!(
-                        "with the 3D element ({why}) the effects that can be switched are {}",
-                        SPATIAL_EFFECTS.join(", ")
-                    ),
+                    &format!(" ({why})"),
                 ));
             }
         }

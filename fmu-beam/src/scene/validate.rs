@@ -1,10 +1,10 @@
 //! Value rules of a scene. Each error names the file, the field and the rule.
 
+use super::rules::{self as r, Rule};
 use super::{
     BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
     SectionSpec,
 };
-use crate::effects::EFFECTS;
 use thiserror::Error;
 
 /// Why a scene was refused.
@@ -20,6 +20,8 @@ pub enum SceneError {
         field: String,
         value: String,
         rule: String,
+        /// The [`Rule::code`] of the rule (`rules::RULES`).
+        code: &'static str,
     },
 }
 
@@ -28,17 +30,30 @@ pub(super) struct Checker<'a> {
 }
 
 impl Checker<'_> {
+    /// The error of `rule` at `field`: its message's rule is the rule's text.
     pub(super) fn fail(
         &self,
+        rule: &Rule,
         field: &str,
         value: impl std::fmt::Display,
-        rule: &str,
+    ) -> SceneError {
+        self.fail_with(rule, field, value, "")
+    }
+
+    /// The same, the rule's text followed by `detail` (the values that decided it).
+    pub(super) fn fail_with(
+        &self,
+        rule: &Rule,
+        field: &str,
+        value: impl std::fmt::Display,
+        detail: &str,
     ) -> SceneError {
         SceneError::Invalid {
             origin: self.origin.to_string(),
             field: field.to_string(),
             value: value.to_string(),
-            rule: rule.to_string(),
+            rule: format!("{}{detail}", rule.text),
+            code: rule.code,
         }
     }
 
@@ -46,7 +61,7 @@ impl Checker<'_> {
         if v.is_finite() {
             Ok(())
         } else {
-            Err(self.fail(field, v, "must be a finite number"))
+            Err(self.fail(&r::FINITE, field, v))
         }
     }
 
@@ -55,7 +70,7 @@ impl Checker<'_> {
         if v > 0.0 {
             Ok(())
         } else {
-            Err(self.fail(field, v, "must be positive"))
+            Err(self.fail(&r::POSITIVE, field, v))
         }
     }
 
@@ -64,7 +79,7 @@ impl Checker<'_> {
         if v >= 0.0 {
             Ok(())
         } else {
-            Err(self.fail(field, v, "must not be negative"))
+            Err(self.fail(&r::NON_NEGATIVE, field, v))
         }
     }
 }
@@ -84,18 +99,10 @@ impl Scene {
     pub(crate) fn validate(&self, origin: &str) -> Result<(), SceneError> {
         let ck = Checker { origin };
         if !is_identifier(&self.name) {
-            return Err(ck.fail(
-                "name",
-                format!("{:?}", self.name),
-                "must be an identifier (letters, digits, _; not starting with a digit)",
-            ));
+            return Err(ck.fail(&r::SCENE_NAME, "name", format!("{:?}", self.name)));
         }
         if !matches!(self.dimensions, 2 | 3) {
-            return Err(ck.fail(
-                "dimensions",
-                self.dimensions,
-                "must be 2 (planar) or 3 (spatial)",
-            ));
+            return Err(ck.fail(&r::DIMENSIONS, "dimensions", self.dimensions));
         }
         for (i, g) in self.world.gravity.iter().enumerate() {
             ck.finite(&format!("world.gravity[{i}]"), *g)?;
@@ -103,42 +110,34 @@ impl Scene {
         let s = &self.solver;
         ck.positive("solver.tolerance", s.tolerance)?;
         if s.tolerance >= 1.0 {
-            return Err(ck.fail("solver.tolerance", s.tolerance, "must be below 1"));
+            return Err(ck.fail(&r::TOLERANCE_BELOW_ONE, "solver.tolerance", s.tolerance));
         }
         ck.positive("solver.max_step", s.max_step)?;
         if s.max_step < MIN_STEP {
-            return Err(ck.fail(
-                "solver.max_step",
-                s.max_step,
-                &format!("must be at least {MIN_STEP:e} s (a smaller step makes no progress)"),
-            ));
+            return Err(ck.fail(&r::MIN_STEP, "solver.max_step", s.max_step));
         }
         ck.finite("solver.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {
-            return Err(ck.fail("solver.rho_inf", s.rho_inf, "must lie in [0, 1]"));
+            return Err(ck.fail(&r::RHO_INF, "solver.rho_inf", s.rho_inf));
         }
         let e = &self.experiment;
         ck.finite("experiment.start_time", e.start_time)?;
         ck.finite("experiment.stop_time", e.stop_time)?;
         if e.stop_time <= e.start_time {
-            return Err(ck.fail(
-                "experiment.stop_time",
-                e.stop_time,
-                "must be after experiment.start_time",
-            ));
+            return Err(ck.fail(&r::STOP_AFTER_START, "experiment.stop_time", e.stop_time));
         }
         ck.positive("experiment.step_size", e.step_size)?;
 
         if self.beams.is_empty() {
-            return Err(ck.fail("beam", "[]", "a scene needs at least one [[beam]]"));
+            return Err(ck.fail(&r::A_BEAM, "beam", "[]"));
         }
         for (i, b) in self.beams.iter().enumerate() {
             validate_beam(&ck, b, i, self.is_3d())?;
             if self.beams[..i].iter().any(|o| o.name == b.name) {
                 return Err(ck.fail(
+                    &r::BEAM_NAMES_UNIQUE,
                     &format!("beam[{i}].name"),
                     format!("{:?}", b.name),
-                    "beam names must be unique",
                 ));
             }
         }
@@ -171,19 +170,11 @@ impl Scene {
                     .map(|(i, l)| (&l.name, format!("load[{i}].name"))),
             );
         for (name, field) in all {
-            if !is_identifier(name) || name == "world" || name == "solver" || name == "energy" {
-                return Err(ck.fail(
-                    &field,
-                    format!("{name:?}"),
-                    "must be an identifier (letters, digits, _; not starting with a digit) other than world, solver, energy",
-                ));
+            if !is_identifier(name) || r::RESERVED_NAMES.contains(&name.as_str()) {
+                return Err(ck.fail(&r::PART_NAME, &field, format!("{name:?}")));
             }
             if names.iter().any(|(n, _)| *n == name.as_str()) {
-                return Err(ck.fail(
-                    &field,
-                    format!("{name:?}"),
-                    "names of beams, bodies, joints and loads must be unique",
-                ));
+                return Err(ck.fail(&r::NAMES_UNIQUE, &field, format!("{name:?}")));
             }
             names.push((name, field));
         }
@@ -192,34 +183,34 @@ impl Scene {
             for (k, f) in j.frames.iter().enumerate() {
                 if !self.frame_exists(f) {
                     return Err(ck.fail(
+                        &r::JOINT_FRAME,
                         &format!("{field}.frames[{k}]"),
                         format!("{f:?}"),
-                        "must be `world`, `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
                     ));
                 }
             }
             if j.frames[0] == j.frames[1] {
                 return Err(ck.fail(
+                    &r::JOINT_FRAMES_DIFFER,
                     &format!("{field}.frames"),
                     format!("{:?}", j.frames),
-                    "a joint connects two different frames",
                 ));
             }
             ck.finite(&format!("{field}.axis_angle"), j.axis_angle)?;
             if let Some(d) = &j.drive {
                 if j.kind == JointKind::Weld {
                     return Err(ck.fail(
+                        &r::WELD_NO_DRIVE,
                         &format!("{field}.drive"),
                         format!("{:?}", d.kind),
-                        "a weld joint has no motion to drive",
                     ));
                 }
                 validate_law(&ck, &d.law, &format!("{field}.drive"))?;
                 if d.kind == DriveKind::Motion && matches!(d.law.law.as_str(), "exponential") {
                     return Err(ck.fail(
+                        &r::MOTION_CONTINUOUS,
                         &format!("{field}.drive.law"),
                         "\"exponential\"",
-                        "a motion drive needs a law with a continuous start (constant, spin_up, table, input)",
                     ));
                 }
             }
@@ -228,17 +219,13 @@ impl Scene {
             let field = format!("load[{i}]");
             if !self.frame_exists(&l.frame) {
                 return Err(ck.fail(
+                    &r::LOAD_FRAME,
                     &format!("{field}.frame"),
                     format!("{:?}", l.frame),
-                    "must be `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
                 ));
             }
             if l.frame == "world" {
-                return Err(ck.fail(
-                    &format!("{field}.frame"),
-                    "\"world\"",
-                    "a load acts on a body",
-                ));
+                return Err(ck.fail(&r::LOAD_ON_BODY, &format!("{field}.frame"), "\"world\""));
             }
             for k in 0..3 {
                 ck.finite(&format!("{field}.force[{k}]"), l.force[k])?;
@@ -248,9 +235,9 @@ impl Scene {
                 validate_law(&ck, law, &format!("{field}.scale"))?;
                 if l.input || law.law == "input" {
                     return Err(ck.fail(
+                        &r::SCALE_NOT_INPUT,
                         &format!("{field}.scale"),
                         format!("{:?}", law.law),
-                        "an input load, or an input law, cannot scale a load (use input = true)",
                     ));
                 }
             }
@@ -276,49 +263,32 @@ impl Scene {
 fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
     let names = match &scene.effects {
         EffectsSpec::Mode(m) if m == "all" || m == "auto" => return Ok(()),
-        EffectsSpec::Mode(m) => {
-            return Err(ck.fail(
-                "effects",
-                format!("{m:?}"),
-                "must be \"all\", \"auto\" or a list of effects",
-            ))
-        }
+        EffectsSpec::Mode(m) => return Err(ck.fail(&r::EFFECTS_MODE, "effects", format!("{m:?}"))),
         EffectsSpec::List(names) => names,
     };
-    let known: Vec<&str> = EFFECTS.iter().map(|(n, _)| *n).collect();
     for (k, n) in names.iter().enumerate() {
-        if !known.contains(&n.as_str()) {
-            return Err(ck.fail(
-                &format!("effects[{k}]"),
-                format!("{n:?}"),
-                &format!("is not an effect; the effects are {}", known.join(", ")),
-            ));
+        if !r::EFFECT_NAMES.contains(&n.as_str()) {
+            return Err(ck.fail(&r::EFFECT_KNOWN, &format!("effects[{k}]"), format!("{n:?}")));
         }
         if names[..k].contains(n) {
-            return Err(ck.fail(
-                &format!("effects[{k}]"),
-                format!("{n:?}"),
-                "is listed twice",
-            ));
+            return Err(ck.fail(&r::EFFECT_ONCE, &format!("effects[{k}]"), format!("{n:?}")));
         }
     }
     let on = |e: &str| names.iter().any(|n| n == e);
     for (i, b) in scene.beams.iter().enumerate() {
         if !on("flexibility") && b.initial.tip_displacement != 0.0 {
             return Err(ck.fail(
+                &r::DEFORMED_NEEDS_FLEXIBILITY,
                 &format!("beam[{i}].initial.tip_displacement"),
                 b.initial.tip_displacement,
-                "needs the effect \"flexibility\" (a rigid beam cannot start deformed)",
             ));
         }
         if on("geometric_stiffening") && b.geometric_stiffening && !on("axial") {
-            return Err(ck.fail(
+            return Err(ck.fail_with(
+                &r::STIFFENING_NEEDS_AXIAL,
                 "effects",
                 format!("{names:?}"),
-                &format!(
-                    "beam {} asks for geometric stiffening, which needs the effect \"axial\"",
-                    b.name
-                ),
+                &format!(" (beam {})", b.name),
             ));
         }
     }
@@ -328,55 +298,42 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
 fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<(), SceneError> {
     let f = |name: &str| format!("beam[{i}].{name}");
     if !is_identifier(&b.name) {
-        return Err(ck.fail(
-            &f("name"),
-            format!("{:?}", b.name),
-            "must be an identifier (letters, digits, _; not starting with a digit)",
-        ));
+        return Err(ck.fail(&r::SCENE_NAME, &f("name"), format!("{:?}", b.name)));
     }
     ck.positive(&f("length"), b.length)?;
-    let count = |field: &str, n: usize, max: usize| -> Result<(), SceneError> {
+    let count = |field: &str, n: usize, max: (usize, &Rule)| -> Result<(), SceneError> {
         if n == 0 {
-            return Err(ck.fail(&f(field), n, "must be at least 1"));
+            return Err(ck.fail(&r::AT_LEAST_ONE, &f(field), n));
         }
-        if n > max {
-            return Err(ck.fail(&f(field), n, &format!("must be at most {max}")));
+        if n > max.0 {
+            return Err(ck.fail(max.1, &f(field), n));
         }
         Ok(())
     };
+    const ELEMENTS: (usize, &Rule) = (2000, &r::ELEMENTS_MAX);
     match (b.elements, b.substructures, b.elements_per_substructure) {
-        (Some(n), None, None) => count("elements", n, 2000)?,
+        (Some(n), None, None) => count("elements", n, ELEMENTS)?,
         (None, Some(k), Some(n)) => {
-            count("substructures", k, 500)?;
-            count("elements_per_substructure", n, 2000)?;
+            count("substructures", k, (500, &r::SUBSTRUCTURES_MAX))?;
+            count("elements_per_substructure", n, ELEMENTS)?;
         }
-        (None, None, _) => {
-            return Err(ck.fail(
-                &f("elements"),
-                "missing",
-                "give `elements`, or `substructures` with `elements_per_substructure`",
-            ))
-        }
+        (None, None, _) => return Err(ck.fail(&r::LAYOUT_MISSING, &f("elements"), "missing")),
         (None, Some(_), None) => {
             return Err(ck.fail(
+                &r::LAYOUT_PER_SUBSTRUCTURE,
                 &f("elements_per_substructure"),
                 "missing",
-                "is required with `substructures`",
             ))
         }
         (Some(n), Some(_), _) | (Some(n), None, Some(_)) => {
-            return Err(ck.fail(
-                &f("elements"),
-                n,
-                "give either `elements` (one frame) or `substructures` with `elements_per_substructure`",
-            ))
+            return Err(ck.fail(&r::LAYOUT_EITHER, &f("elements"), n))
         }
     }
     if b.substructures.is_some() && b.initial.tip_displacement != 0.0 {
         return Err(ck.fail(
+            &r::DEFORMED_SINGLE_FRAME,
             &f("initial.tip_displacement"),
             b.initial.tip_displacement,
-            "is only available for single-frame beams (`elements`)",
         ));
     }
     if b.rigid
@@ -384,24 +341,13 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<()
             || b.geometric_stiffening
             || b.initial.tip_displacement != 0.0)
     {
-        return Err(ck.fail(
-            &f("rigid"),
-            true,
-            "a rigid beam has no substructures, stiffening or initial deformation",
-        ));
+        return Err(ck.fail(&r::RIGID_PLAIN, &f("rigid"), true));
     }
     if let Some(m) = b.modes {
         let (elements, _) = Scene::beam_layout(b);
         let nodal = 3 * elements; // the frame removes 3 of the 3 (N + 1) nodal coordinates
         if m == 0 || m > nodal || b.rigid {
-            return Err(ck.fail(
-                &f("modes"),
-                m,
-                &format!(
-                    "must lie between 1 and the {nodal} deformation coordinates of a frame \
-                     of a flexible beam"
-                ),
-            ));
+            return Err(ck.fail_with(&r::MODES_RANGE, &f("modes"), m, &format!(": {nodal} here")));
         }
     }
     ck.positive(&f("material.rho"), b.material.rho)?;
@@ -421,42 +367,31 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<()
     ck.finite(&f("initial.tip_displacement"), b.initial.tip_displacement)?;
     if b.initial.tip_displacement.abs() > 0.5 * b.length {
         return Err(ck.fail(
+            &r::DEFORMATION_SMALL,
             &f("initial.tip_displacement"),
             b.initial.tip_displacement,
-            "must be small against the length (at most half of it)",
         ));
     }
     if b.initial.tip_displacement != 0.0 && b.frame == FrameKind::Pinned {
         return Err(ck.fail(
+            &r::DEFORMED_TANGENT,
             &f("initial.tip_displacement"),
             b.initial.tip_displacement,
-            "needs frame = \"tangent\" (a pinned frame holds the tip on its axis)",
         ));
     }
-    let outputs: &[&str] = if three {
-        &super::BEAM_OUTPUTS_3D
+    let (outputs, rule): (&[&str], _) = if three {
+        (&super::BEAM_OUTPUT_NAMES_3D, &r::BEAM_OUTPUT_3D)
     } else {
-        &super::BEAM_OUTPUTS
+        (&super::BEAM_OUTPUT_NAMES, &r::BEAM_OUTPUT)
     };
     for (k, o) in b.outputs.iter().enumerate() {
-        if !outputs.contains(&o.as_str()) && o != super::SHAPE_OUTPUT {
-            return Err(ck.fail(
-                &f(&format!("outputs[{k}]")),
-                format!("{o:?}"),
-                &format!("must be one of {outputs:?} or {:?}", super::SHAPE_OUTPUT),
-            ));
+        if !outputs.contains(&o.as_str()) {
+            return Err(ck.fail(rule, &f(&format!("outputs[{k}]")), format!("{o:?}")));
         }
     }
     if let Some(n) = b.shape_points {
         if n == 1 || n > crate::shape::MAX_POINTS {
-            return Err(ck.fail(
-                &f("shape_points"),
-                n,
-                &format!(
-                    "must be 0 (no shape outputs) or 2 to {} (points from flange a to flange b)",
-                    crate::shape::MAX_POINTS
-                ),
-            ));
+            return Err(ck.fail(&r::SHAPE_POINTS, &f("shape_points"), n));
         }
     }
     Ok(())
@@ -475,67 +410,44 @@ fn validate_section(
                 ck.positive(&f(name), x)?;
                 Ok(x)
             }
-            None => Err(ck.fail(&f(name), "missing", "is required for this section")),
+            None => Err(ck.fail(&r::SECTION_VALUE_MISSING, &f(name), "missing")),
         }
     };
-    let unused = |v: Option<f64>, name: &str, why: &str| -> Result<(), SceneError> {
+    let unused = |v: Option<f64>, name: &str, rule: &Rule| -> Result<(), SceneError> {
         match v {
-            Some(x) => Err(ck.fail(&f(name), x, why)),
+            Some(x) => Err(ck.fail(rule, &f(name), x)),
             None => Ok(()),
         }
     };
     let spatial = [(s.iy, "Iy"), (s.iz, "Iz"), (s.torsion_constant, "It")];
     if !three {
         for (v, n) in spatial {
-            unused(
-                v,
-                n,
-                "is for 3D scenes (dimensions = 3); a planar section has A and J",
-            )?;
+            unused(v, n, &r::SECTION_3D_CONSTANTS)?;
         }
     }
+    let dimensions = [(s.a, "a"), (s.b, "b"), (s.d, "d"), (s.t, "t")];
     match s.shape.as_deref() {
         None if three => {
-            unused(
-                s.second_moment,
-                "J",
-                "is the planar second moment; a 3D section gives Iy, Iz and It",
-            )?;
+            unused(s.second_moment, "J", &r::SECTION_PLANAR_J)?;
             if spatial.iter().all(|(v, _)| v.is_none()) && s.area.is_none() {
-                return Err(ck.fail(
-                    field,
-                    "missing",
-                    "give `A`, `Iy`, `Iz` and `It`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
-                ));
+                return Err(ck.fail(&r::SECTION_MISSING_3D, field, "missing"));
             }
             given(s.area, "A")?;
             for (v, n) in spatial {
                 given(v, n)?;
             }
-            for (v, n) in [(s.a, "a"), (s.b, "b"), (s.d, "d"), (s.t, "t")] {
-                unused(
-                    v,
-                    n,
-                    "belongs to a `shape`; with the constants given it is not used",
-                )?;
+            for (v, n) in dimensions {
+                unused(v, n, &r::SHAPE_DIMENSION_UNUSED)?;
             }
         }
         None => {
             if s.area.is_none() && s.second_moment.is_none() {
-                return Err(ck.fail(
-                    field,
-                    "missing",
-                    "give `A` and `J`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
-                ));
+                return Err(ck.fail(&r::SECTION_MISSING, field, "missing"));
             }
             given(s.area, "A")?;
             given(s.second_moment, "J")?;
-            for (v, n) in [(s.a, "a"), (s.b, "b"), (s.d, "d"), (s.t, "t")] {
-                unused(
-                    v,
-                    n,
-                    "belongs to a `shape`; with `A` and `J` given it is not used",
-                )?;
+            for (v, n) in dimensions {
+                unused(v, n, &r::SHAPE_DIMENSION_UNUSED)?;
             }
         }
         Some(shape) => {
@@ -543,50 +455,40 @@ fn validate_section(
                 .into_iter()
                 .chain(spatial)
             {
-                unused(
-                    v,
-                    n,
-                    "is computed from the `shape`; give either the shape or A and J",
-                )?;
+                unused(v, n, &r::CONSTANT_FROM_SHAPE)?;
             }
             match shape {
                 "rectangle" => {
                     given(s.a, "a")?;
                     given(s.b, "b")?;
-                    unused(s.d, "d", "is not a dimension of a rectangle")?;
-                    unused(s.t, "t", "is for hollow shapes")?;
+                    unused(s.d, "d", &r::NOT_OF_RECTANGLE)?;
+                    unused(s.t, "t", &r::HOLLOW_ONLY)?;
                 }
                 "hollow_rectangle" => {
                     let a = given(s.a, "a")?;
                     let b = given(s.b, "b")?;
                     let t = given(s.t, "t")?;
-                    unused(s.d, "d", "is not a dimension of a rectangle")?;
+                    unused(s.d, "d", &r::NOT_OF_RECTANGLE)?;
                     if 2.0 * t >= a.min(b) {
-                        return Err(ck.fail(&f("t"), t, "must be less than half of min(a, b)"));
+                        return Err(ck.fail(&r::WALL_OF_RECTANGLE, &f("t"), t));
                     }
                 }
                 "circle" => {
                     given(s.d, "d")?;
-                    unused(s.a, "a", "is not a dimension of a circle")?;
-                    unused(s.b, "b", "is not a dimension of a circle")?;
-                    unused(s.t, "t", "is for hollow shapes")?;
+                    unused(s.a, "a", &r::NOT_OF_CIRCLE)?;
+                    unused(s.b, "b", &r::NOT_OF_CIRCLE)?;
+                    unused(s.t, "t", &r::HOLLOW_ONLY)?;
                 }
                 "hollow_circle" => {
                     let d = given(s.d, "d")?;
                     let t = given(s.t, "t")?;
-                    unused(s.a, "a", "is not a dimension of a circle")?;
-                    unused(s.b, "b", "is not a dimension of a circle")?;
+                    unused(s.a, "a", &r::NOT_OF_CIRCLE)?;
+                    unused(s.b, "b", &r::NOT_OF_CIRCLE)?;
                     if 2.0 * t >= d {
-                        return Err(ck.fail(&f("t"), t, "must be less than half of d"));
+                        return Err(ck.fail(&r::WALL_OF_CIRCLE, &f("t"), t));
                     }
                 }
-                other => {
-                    return Err(ck.fail(
-                        &f("shape"),
-                        format!("{other:?}"),
-                        "must be one of rectangle, circle, hollow_rectangle, hollow_circle",
-                    ))
-                }
+                other => return Err(ck.fail(&r::SHAPE, &f("shape"), format!("{other:?}"))),
             }
         }
     }
@@ -603,18 +505,18 @@ fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Resu
     }
     if three && b.mass > 0.0 && b.inertia.contains(&0.0) {
         return Err(ck.fail(
+            &r::BODY_INERTIA_3D,
             &f("inertia"),
             format!("{:?}", b.inertia),
-            "a 3D body with mass needs inertia = [Ixx, Iyy, Izz] (principal, body axes), each positive",
         ));
     }
     ck.finite(&f("angle"), b.angle)?;
     for (name, p) in &b.frames {
         if !is_identifier(name) || name == "a" || name == "b" {
             return Err(ck.fail(
+                &r::FRAME_NAME,
                 &f(&format!("frames.{name}")),
                 format!("{name:?}"),
-                "frame names are identifiers other than a and b",
             ));
         }
         for k in 0..3 {
@@ -628,10 +530,11 @@ pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(),
     let f = |name: &str| format!("{field}.{name}");
     let need = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
         let x = v.ok_or_else(|| {
-            ck.fail(
+            ck.fail_with(
+                &r::LAW_PARAMETER,
                 &f(name),
                 "missing",
-                &format!("is required by law \"{}\"", l.law),
+                &format!(" \"{}\"", l.law),
             )
         })?;
         ck.finite(&f(name), x)?;
@@ -653,22 +556,17 @@ pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(),
             ck.positive(&f("ramp_time"), need(l.ramp_time, "ramp_time")?)?;
         }
         "table" => {
-            let t = l
-                .table
-                .as_ref()
-                .ok_or_else(|| ck.fail(&f("table"), "missing", "is required by law \"table\""))?;
+            let t = l.table.as_ref().ok_or_else(|| {
+                ck.fail_with(&r::LAW_PARAMETER, &f("table"), "missing", " \"table\"")
+            })?;
             if t.len() < 2 {
-                return Err(ck.fail(&f("table"), t.len(), "needs at least two rows [t, value]"));
+                return Err(ck.fail(&r::TABLE_ROWS, &f("table"), t.len()));
             }
             for (k, row) in t.iter().enumerate() {
                 ck.finite(&f(&format!("table[{k}][0]")), row[0])?;
                 ck.finite(&f(&format!("table[{k}][1]")), row[1])?;
                 if k > 0 && row[0] <= t[k - 1][0] {
-                    return Err(ck.fail(
-                        &f(&format!("table[{k}][0]")),
-                        row[0],
-                        "times must increase",
-                    ));
+                    return Err(ck.fail(&r::TABLE_TIMES, &f(&format!("table[{k}][0]")), row[0]));
                 }
             }
         }
@@ -677,13 +575,7 @@ pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(),
                 ck.finite(&f("value"), v)?;
             }
         }
-        other => {
-            return Err(ck.fail(
-                &f("law"),
-                format!("{other:?}"),
-                "must be one of constant, exponential, spin_up, table, input",
-            ))
-        }
+        other => return Err(ck.fail(&r::LAW, &f("law"), format!("{other:?}"))),
     }
     Ok(())
 }

@@ -98,3 +98,39 @@ impl<'de> Visitor<'de> for Xyz {
         }
     }
 }
+
+/// The JSON-Schema forms of these vectors (`fmu-harness schema`).
+#[cfg(feature = "schema")]
+pub mod schema {
+    use schemars::{json_schema, Schema, SchemaGenerator};
+
+    /// `[x, y]` or `[x, y, z]`.
+    pub fn point(_: &mut SchemaGenerator) -> Schema {
+        json_schema!({
+            "type": "array",
+            "items": { "type": "number" },
+            "minItems": 2,
+            "maxItems": 3
+        })
+    }
+
+    /// A number (about z) or `[x, y, z]`.
+    pub fn about_z(_: &mut SchemaGenerator) -> Schema {
+        json_schema!({
+            "anyOf": [
+                { "type": "number" },
+                { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3 }
+            ]
+        })
+    }
+
+    /// `[x, y, z]`.
+    pub fn direction(_: &mut SchemaGenerator) -> Schema {
+        json_schema!({
+            "type": "array",
+            "items": { "type": "number" },
+            "minItems": 3,
+            "maxItems": 3
+        })
+    }
+}

@@ -1,0 +1,917 @@
+//! The value rules of a scene, as one table: the validator (`validate.rs`, `space.rs`) refuses
+//! a scene only through a [`Rule`] of [`RULES`], whose text is the message's rule; the packager
+//! writes the same table into the scene reference (`docs/scene-reference.md`) and, where a rule
+//! has a JSON-Schema form ([`Schema`]), into the scene schema. A test refuses one scene per rule
+//! (`tests/refused_scenes.toml`) and checks the rule's code and field; so the page lists what the
+//! validator does, no more and no less.
+
+/// Which scenes a rule applies to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dims {
+    /// Planar and 3D scenes.
+    Any,
+    /// Planar scenes (`dimensions = 2`).
+    Planar,
+    /// 3D scenes (`dimensions = 3`).
+    Spatial,
+}
+
+/// How a rule reads in JSON Schema, where it has a form there (draft-07 keywords on the rule's
+/// fields; in a scene of one kind only, under `if dimensions = 3`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Schema {
+    /// Not expressed in the schema (it needs other fields' values, or arithmetic).
+    None,
+    /// `exclusiveMinimum`.
+    Above(f64),
+    /// `minimum`.
+    AtLeast(f64),
+    /// `maximum`.
+    AtMost(f64),
+    /// `exclusiveMaximum`.
+    Below(f64),
+    /// `minimum` and `maximum`.
+    Within(f64, f64),
+    /// `enum` of strings (on a string, or on an array's items).
+    OneOf(&'static [&'static str]),
+    /// `enum` of integers.
+    OneOfIntegers(&'static [i64]),
+    /// An identifier (`pattern`) other than these names (`not enum`); on a table's keys for a
+    /// field `<name>`.
+    Identifier(&'static [&'static str]),
+    /// `not enum`: any value but these.
+    NoneOf(&'static [&'static str]),
+    /// The field must be absent.
+    Absent,
+    /// The field must be absent when the sibling field (`type`) has this value.
+    AbsentWhen(&'static str, &'static str),
+    /// The field is present, with at least this many items.
+    Required(usize),
+    /// `minItems`.
+    MinItems(usize),
+    /// `uniqueItems` on the array.
+    Unique,
+    /// The beam's layout: `elements`, or `substructures` with `elements_per_substructure`.
+    BeamLayout,
+    /// The parameters each time law needs.
+    LawParameters,
+}
+
+/// One rule of the validator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rule {
+    /// Stable name, used by the reference and the tests.
+    pub code: &'static str,
+    /// The fields it checks: `beam[].length` (`[]`: any index, `<name>`: any key; `*`: any
+    /// number of the scene).
+    pub fields: &'static [&'static str],
+    /// The message's rule (some messages add the values that decided it).
+    pub text: &'static str,
+    pub dims: Dims,
+    pub schema: Schema,
+}
+
+const fn rule(
+    code: &'static str,
+    fields: &'static [&'static str],
+    text: &'static str,
+    dims: Dims,
+    schema: Schema,
+) -> Rule {
+    Rule {
+        code,
+        fields,
+        text,
+        dims,
+        schema,
+    }
+}
+
+use Dims::{Any, Planar, Spatial};
+
+/// The time laws of drives and load scales.
+pub const LAWS: [&str; 5] = ["constant", "exponential", "spin_up", "table", "input"];
+/// The section shapes.
+pub const SHAPES: [&str; 4] = ["rectangle", "circle", "hollow_rectangle", "hollow_circle"];
+/// The effects a scene can list (`crate::effects::EFFECTS`, by name).
+pub const EFFECT_NAMES: [&str; 6] = [
+    "gravity",
+    "flexibility",
+    "axial",
+    "quadratic_velocity",
+    "geometric_stiffening",
+    "rayleigh_damping",
+];
+/// Names that a beam, body, joint or load cannot take (they start other variables' names).
+pub const RESERVED_NAMES: [&str; 3] = ["world", "solver", "energy"];
+/// Which parameters each law needs.
+pub const LAW_PARAMETERS: [(&str, &[&str]); 4] = [
+    ("constant", &["value"]),
+    ("exponential", &["value", "time_constant"]),
+    ("spin_up", &["omega", "ramp_time"]),
+    ("table", &["table"]),
+];
+
+const IDENTIFIER: &str = "must be an identifier (letters, digits, _; not starting with a digit)";
+const ONLY_3D: &str = "is for 3D scenes (dimensions = 3)";
+const PLANE: &str =
+    "a planar scene lies in the world x–y plane (z = 0); write dimensions = 3 for a 3D scene";
+
+pub const FINITE: Rule = rule(
+    "finite",
+    &["*"],
+    "must be a finite number",
+    Any,
+    Schema::None,
+);
+pub const POSITIVE: Rule = rule(
+    "positive",
+    &[
+        "solver.tolerance",
+        "solver.max_step",
+        "experiment.step_size",
+        "beam[].length",
+        "beam[].material.rho",
+        "beam[].material.E",
+        "beam[].material.G",
+        "beam[].section.A",
+        "beam[].section.J",
+        "beam[].section.Iy",
+        "beam[].section.Iz",
+        "beam[].section.It",
+        "beam[].section.a",
+        "beam[].section.b",
+        "beam[].section.d",
+        "beam[].section.t",
+        "joint[].drive.time_constant",
+        "joint[].drive.ramp_time",
+        "load[].scale.time_constant",
+        "load[].scale.ramp_time",
+    ],
+    "must be positive",
+    Any,
+    Schema::Above(0.0),
+);
+pub const NON_NEGATIVE: Rule = rule(
+    "non_negative",
+    &[
+        "beam[].rayleigh.alpha",
+        "beam[].rayleigh.beta",
+        "body[].mass",
+        "body[].inertia[]",
+        "joint[].drive.until",
+        "load[].scale.until",
+    ],
+    "must not be negative",
+    Any,
+    Schema::AtLeast(0.0),
+);
+pub const SCENE_NAME: Rule = rule(
+    "name",
+    &["name", "beam[].name"],
+    IDENTIFIER,
+    Any,
+    Schema::Identifier(&[]),
+);
+pub const DIMENSIONS: Rule = rule(
+    "dimensions",
+    &["dimensions"],
+    "must be 2 (planar) or 3 (spatial)",
+    Any,
+    Schema::OneOfIntegers(&[2, 3]),
+);
+pub const TOLERANCE_BELOW_ONE: Rule = rule(
+    "tolerance_below_one",
+    &["solver.tolerance"],
+    "must be below 1",
+    Any,
+    Schema::Below(1.0),
+);
+/// Its text quotes [`super::validate::MIN_STEP`] (a test checks it).
+pub const MIN_STEP: Rule = rule(
+    "min_step",
+    &["solver.max_step"],
+    "must be at least 1e-9 s (a smaller step makes no progress)",
+    Any,
+    Schema::AtLeast(super::validate::MIN_STEP),
+);
+pub const RHO_INF: Rule = rule(
+    "rho_inf",
+    &["solver.rho_inf"],
+    "must lie in [0, 1]",
+    Any,
+    Schema::Within(0.0, 1.0),
+);
+pub const STOP_AFTER_START: Rule = rule(
+    "stop_after_start",
+    &["experiment.stop_time"],
+    "must be after experiment.start_time",
+    Any,
+    Schema::None,
+);
+pub const A_BEAM: Rule = rule(
+    "a_beam",
+    &["beam"],
+    "a scene needs at least one [[beam]]",
+    Any,
+    Schema::Required(1),
+);
+pub const BEAM_NAMES_UNIQUE: Rule = rule(
+    "beam_names_unique",
+    &["beam[].name"],
+    "beam names must be unique",
+    Any,
+    Schema::None,
+);
+pub const PART_NAME: Rule = rule(
+    "part_name",
+    &["beam[].name", "body[].name", "joint[].name", "load[].name"],
+    "must be an identifier (letters, digits, _; not starting with a digit) other than world, solver, energy",
+    Any,
+    Schema::Identifier(&RESERVED_NAMES),
+);
+pub const NAMES_UNIQUE: Rule = rule(
+    "names_unique",
+    &["beam[].name", "body[].name", "joint[].name", "load[].name"],
+    "names of beams, bodies, joints and loads must be unique",
+    Any,
+    Schema::None,
+);
+pub const JOINT_FRAME: Rule = rule(
+    "joint_frame",
+    &["joint[].frames[]"],
+    "must be `world`, `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
+    Any,
+    Schema::None,
+);
+pub const JOINT_FRAMES_DIFFER: Rule = rule(
+    "joint_frames_differ",
+    &["joint[].frames"],
+    "a joint connects two different frames",
+    Any,
+    Schema::Unique,
+);
+pub const WELD_NO_DRIVE: Rule = rule(
+    "weld_no_drive",
+    &["joint[].drive"],
+    "a weld joint has no motion to drive",
+    Any,
+    Schema::AbsentWhen("type", "weld"),
+);
+pub const MOTION_CONTINUOUS: Rule = rule(
+    "motion_continuous",
+    &["joint[].drive.law"],
+    "a motion drive needs a law with a continuous start (constant, spin_up, table, input)",
+    Any,
+    Schema::None,
+);
+pub const LOAD_FRAME: Rule = rule(
+    "load_frame",
+    &["load[].frame"],
+    "must be `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
+    Any,
+    Schema::None,
+);
+pub const LOAD_ON_BODY: Rule = rule(
+    "load_on_body",
+    &["load[].frame"],
+    "a load acts on a body",
+    Any,
+    Schema::NoneOf(&["world"]),
+);
+pub const SCALE_NOT_INPUT: Rule = rule(
+    "scale_not_input",
+    &["load[].scale"],
+    "an input load, or an input law, cannot scale a load (use input = true)",
+    Any,
+    Schema::None,
+);
+pub const EFFECTS_MODE: Rule = rule(
+    "effects_mode",
+    &["effects"],
+    "must be \"all\", \"auto\" or a list of effects",
+    Any,
+    Schema::OneOf(&["all", "auto"]),
+);
+pub const EFFECT_KNOWN: Rule = rule(
+    "effect_known",
+    &["effects[]"],
+    "is not an effect; the effects are gravity, flexibility, axial, quadratic_velocity, geometric_stiffening, rayleigh_damping",
+    Any,
+    Schema::OneOf(&EFFECT_NAMES),
+);
+pub const EFFECT_ONCE: Rule = rule(
+    "effect_once",
+    &["effects[]"],
+    "is listed twice",
+    Any,
+    Schema::Unique,
+);
+pub const DEFORMED_NEEDS_FLEXIBILITY: Rule = rule(
+    "deformed_needs_flexibility",
+    &["beam[].initial.tip_displacement"],
+    "needs the effect \"flexibility\" (a rigid beam cannot start deformed)",
+    Any,
+    Schema::None,
+);
+pub const STIFFENING_NEEDS_AXIAL: Rule = rule(
+    "stiffening_needs_axial",
+    &["effects"],
+    "a beam that asks for geometric stiffening needs the effect \"axial\" in the list",
+    Any,
+    Schema::None,
+);
+pub const AT_LEAST_ONE: Rule = rule(
+    "at_least_one",
+    &[
+        "beam[].elements",
+        "beam[].substructures",
+        "beam[].elements_per_substructure",
+    ],
+    "must be at least 1",
+    Any,
+    Schema::AtLeast(1.0),
+);
+pub const ELEMENTS_MAX: Rule = rule(
+    "elements_max",
+    &["beam[].elements", "beam[].elements_per_substructure"],
+    "must be at most 2000",
+    Any,
+    Schema::AtMost(2000.0),
+);
+pub const SUBSTRUCTURES_MAX: Rule = rule(
+    "substructures_max",
+    &["beam[].substructures"],
+    "must be at most 500",
+    Any,
+    Schema::AtMost(500.0),
+);
+pub const LAYOUT_MISSING: Rule = rule(
+    "layout_missing",
+    &["beam[].elements"],
+    "give `elements`, or `substructures` with `elements_per_substructure`",
+    Any,
+    Schema::BeamLayout,
+);
+pub const LAYOUT_PER_SUBSTRUCTURE: Rule = rule(
+    "layout_per_substructure",
+    &["beam[].elements_per_substructure"],
+    "is required with `substructures`",
+    Any,
+    Schema::BeamLayout,
+);
+pub const LAYOUT_EITHER: Rule = rule(
+    "layout_either",
+    &["beam[].elements"],
+    "give either `elements` (one frame) or `substructures` with `elements_per_substructure`",
+    Any,
+    Schema::BeamLayout,
+);
+pub const DEFORMED_SINGLE_FRAME: Rule = rule(
+    "deformed_single_frame",
+    &["beam[].initial.tip_displacement"],
+    "is only available for single-frame beams (`elements`)",
+    Any,
+    Schema::None,
+);
+pub const RIGID_PLAIN: Rule = rule(
+    "rigid_plain",
+    &["beam[].rigid"],
+    "a rigid beam has no substructures, stiffening or initial deformation",
+    Any,
+    Schema::None,
+);
+pub const MODES_RANGE: Rule = rule(
+    "modes_range",
+    &["beam[].modes"],
+    "must lie between 1 and the deformation coordinates of a frame of a flexible beam (3 per element)",
+    Any,
+    Schema::AtLeast(1.0),
+);
+pub const SECTION_MISSING: Rule = rule(
+    "section_missing",
+    &["beam[].section"],
+    "give `A` and `J`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
+    Planar,
+    Schema::None,
+);
+pub const SECTION_MISSING_3D: Rule = rule(
+    "section_missing_3d",
+    &["beam[].section"],
+    "give `A`, `Iy`, `Iz` and `It`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
+    Spatial,
+    Schema::None,
+);
+pub const SECTION_VALUE_MISSING: Rule = rule(
+    "section_value_missing",
+    &[
+        "beam[].section.A",
+        "beam[].section.J",
+        "beam[].section.Iy",
+        "beam[].section.Iz",
+        "beam[].section.It",
+        "beam[].section.a",
+        "beam[].section.b",
+        "beam[].section.d",
+        "beam[].section.t",
+    ],
+    "is required for this section",
+    Any,
+    Schema::None,
+);
+pub const SECTION_3D_CONSTANTS: Rule = rule(
+    "section_3d_constants",
+    &[
+        "beam[].section.Iy",
+        "beam[].section.Iz",
+        "beam[].section.It",
+    ],
+    "is for 3D scenes (dimensions = 3); a planar section has A and J",
+    Planar,
+    Schema::Absent,
+);
+pub const SECTION_PLANAR_J: Rule = rule(
+    "section_planar_j",
+    &["beam[].section.J"],
+    "is the planar second moment; a 3D section gives Iy, Iz and It",
+    Spatial,
+    Schema::Absent,
+);
+pub const SHAPE_DIMENSION_UNUSED: Rule = rule(
+    "shape_dimension_unused",
+    &[
+        "beam[].section.a",
+        "beam[].section.b",
+        "beam[].section.d",
+        "beam[].section.t",
+    ],
+    "belongs to a `shape`; with the section constants given it is not used",
+    Any,
+    Schema::None,
+);
+pub const CONSTANT_FROM_SHAPE: Rule = rule(
+    "constant_from_shape",
+    &[
+        "beam[].section.A",
+        "beam[].section.J",
+        "beam[].section.Iy",
+        "beam[].section.Iz",
+        "beam[].section.It",
+    ],
+    "is computed from the `shape`; give either the shape or A and J",
+    Any,
+    Schema::None,
+);
+pub const NOT_OF_RECTANGLE: Rule = rule(
+    "not_of_rectangle",
+    &["beam[].section.d"],
+    "is not a dimension of a rectangle",
+    Any,
+    Schema::None,
+);
+pub const NOT_OF_CIRCLE: Rule = rule(
+    "not_of_circle",
+    &["beam[].section.a", "beam[].section.b"],
+    "is not a dimension of a circle",
+    Any,
+    Schema::None,
+);
+pub const HOLLOW_ONLY: Rule = rule(
+    "hollow_only",
+    &["beam[].section.t"],
+    "is for hollow shapes",
+    Any,
+    Schema::None,
+);
+pub const WALL_OF_RECTANGLE: Rule = rule(
+    "wall_of_rectangle",
+    &["beam[].section.t"],
+    "must be less than half of min(a, b)",
+    Any,
+    Schema::None,
+);
+pub const WALL_OF_CIRCLE: Rule = rule(
+    "wall_of_circle",
+    &["beam[].section.t"],
+    "must be less than half of d",
+    Any,
+    Schema::None,
+);
+pub const SHAPE: Rule = rule(
+    "shape",
+    &["beam[].section.shape"],
+    "must be one of rectangle, circle, hollow_rectangle, hollow_circle",
+    Any,
+    Schema::OneOf(&SHAPES),
+);
+pub const DEFORMATION_SMALL: Rule = rule(
+    "deformation_small",
+    &["beam[].initial.tip_displacement"],
+    "must be small against the length (at most half of it)",
+    Any,
+    Schema::None,
+);
+pub const DEFORMED_TANGENT: Rule = rule(
+    "deformed_tangent",
+    &["beam[].initial.tip_displacement"],
+    "needs frame = \"tangent\" (a pinned frame holds the tip on its axis)",
+    Any,
+    Schema::None,
+);
+pub const BEAM_OUTPUT: Rule = rule(
+    "beam_output",
+    &["beam[].outputs[]"],
+    "must be one of tip.deflection, tip.x, tip.y, tip.phi, mid.deflection, shape",
+    Planar,
+    Schema::OneOf(&super::BEAM_OUTPUT_NAMES),
+);
+pub const BEAM_OUTPUT_3D: Rule = rule(
+    "beam_output_3d",
+    &["beam[].outputs[]"],
+    "must be one of tip.x, tip.y, tip.z, tip.deflection_y, tip.deflection_z, tip.twist, shape",
+    Spatial,
+    Schema::OneOf(&super::BEAM_OUTPUT_NAMES_3D),
+);
+pub const SHAPE_POINTS: Rule = rule(
+    "shape_points",
+    &["beam[].shape_points"],
+    "must be 0 (no shape outputs) or 2 to 1000 (points from flange a to flange b)",
+    Any,
+    Schema::AtMost(1000.0),
+);
+pub const BODY_INERTIA_3D: Rule = rule(
+    "body_inertia_3d",
+    &["body[].inertia"],
+    "a 3D body with mass needs inertia = [Ixx, Iyy, Izz] (principal, body axes), each positive",
+    Spatial,
+    Schema::None,
+);
+pub const FRAME_NAME: Rule = rule(
+    "frame_name",
+    &["body[].frames.<name>"],
+    "frame names are identifiers other than a and b",
+    Any,
+    Schema::Identifier(&["a", "b"]),
+);
+pub const LAW_PARAMETER: Rule = rule(
+    "law_parameter",
+    &[
+        "joint[].drive.value",
+        "joint[].drive.time_constant",
+        "joint[].drive.omega",
+        "joint[].drive.ramp_time",
+        "joint[].drive.table",
+        "load[].scale.value",
+        "load[].scale.time_constant",
+        "load[].scale.omega",
+        "load[].scale.ramp_time",
+        "load[].scale.table",
+    ],
+    "is required by law",
+    Any,
+    Schema::LawParameters,
+);
+pub const TABLE_ROWS: Rule = rule(
+    "table_rows",
+    &["joint[].drive.table", "load[].scale.table"],
+    "needs at least two rows [t, value]",
+    Any,
+    Schema::MinItems(2),
+);
+pub const TABLE_TIMES: Rule = rule(
+    "table_times",
+    &["joint[].drive.table[][]", "load[].scale.table[][]"],
+    "times must increase",
+    Any,
+    Schema::None,
+);
+pub const LAW: Rule = rule(
+    "law",
+    &["joint[].drive.law", "load[].scale.law"],
+    "must be one of constant, exponential, spin_up, table, input",
+    Any,
+    Schema::OneOf(&LAWS),
+);
+pub const ONLY_3D_FIELD: Rule = rule(
+    "only_3d_field",
+    &[
+        "beam[].axis",
+        "beam[].normal",
+        "beam[].matrix_file",
+        "joint[].axis",
+    ],
+    ONLY_3D,
+    Planar,
+    Schema::Absent,
+);
+pub const SPATIAL_FORMULATION: Rule = rule(
+    "spatial_formulation",
+    &["formulation"],
+    ONLY_3D,
+    Planar,
+    Schema::NoneOf(&["spatial"]),
+);
+pub const FROZEN_INERTIA: Rule = rule(
+    "frozen_inertia",
+    &["beam[].inertia"],
+    ONLY_3D,
+    Planar,
+    Schema::NoneOf(&["frozen"]),
+);
+pub const SPHERICAL: Rule = rule(
+    "spherical",
+    &["joint[].type"],
+    ONLY_3D,
+    Planar,
+    Schema::NoneOf(&["spherical"]),
+);
+pub const IN_PLANE: Rule = rule(
+    "in_plane",
+    &[
+        "world.gravity[2]",
+        "beam[].position[2]",
+        "body[].position[2]",
+        "body[].com[2]",
+        "body[].frames.<name>[2]",
+        "load[].force[2]",
+    ],
+    PLANE,
+    Planar,
+    Schema::None,
+);
+pub const PLANAR_INERTIA: Rule = rule(
+    "planar_inertia",
+    &["body[].inertia[0]", "body[].inertia[1]"],
+    "a planar body has one moment of inertia (about z): give a number",
+    Planar,
+    Schema::None,
+);
+pub const PLANAR_TORQUE: Rule = rule(
+    "planar_torque",
+    &["load[].torque[0]", "load[].torque[1]"],
+    "a planar torque acts about z: give a number",
+    Planar,
+    Schema::None,
+);
+pub const DIRECTION: Rule = rule(
+    "direction",
+    &["beam[].axis", "beam[].normal", "joint[].axis"],
+    "must be a non-zero direction",
+    Spatial,
+    Schema::None,
+);
+pub const NORMAL_TO_AXIS: Rule = rule(
+    "normal_to_axis",
+    &["beam[].normal"],
+    "must be normal to the beam axis (it is the section's local z axis)",
+    Spatial,
+    Schema::None,
+);
+pub const NORMAL_REQUIRED: Rule = rule(
+    "normal_required",
+    &["beam[].normal"],
+    "is required when the beam axis leaves the x–y plane (the default is world z)",
+    Spatial,
+    Schema::None,
+);
+pub const SHEAR_MODULUS: Rule = rule(
+    "shear_modulus",
+    &["beam[].material.G"],
+    "a flexible 3D beam needs its shear modulus (torsion)",
+    Spatial,
+    Schema::None,
+);
+pub const PLANAR_ELEMENT_ONLY: Rule = rule(
+    "planar_element_only",
+    &[
+        "beam[].modes",
+        "beam[].geometric_stiffening",
+        "beam[].initial.tip_displacement",
+    ],
+    "is available with the planar element only, and this scene runs with the 3D element",
+    Spatial,
+    Schema::None,
+);
+pub const MATRIX_FILE: Rule = rule(
+    "matrix_file",
+    &["beam[].matrix_file"],
+    "is not a valid matrix file (symmetric 12 x 12 mass and stiffness, see the format)",
+    Spatial,
+    Schema::None,
+);
+pub const MATRIX_ONE_ELEMENT: Rule = rule(
+    "matrix_one_element",
+    &["beam[].matrix_file"],
+    "a matrix-file beam is one flexible element: write elements = 1, no substructures, not rigid",
+    Spatial,
+    Schema::None,
+);
+pub const MATRIX_LENGTH: Rule = rule(
+    "matrix_length",
+    &["beam[].length"],
+    "must equal the matrix file's length",
+    Spatial,
+    Schema::None,
+);
+pub const SPHERICAL_NO_DRIVE: Rule = rule(
+    "spherical_no_drive",
+    &["joint[].drive"],
+    "a spherical joint has no single coordinate to drive",
+    Spatial,
+    Schema::AbsentWhen("type", "spherical"),
+);
+pub const SPATIAL_EFFECTS: Rule = rule(
+    "spatial_effects",
+    &["effects[]"],
+    "with the 3D element, the effects that can be switched are gravity, flexibility, rayleigh_damping",
+    Spatial,
+    Schema::None,
+);
+
+/// Every rule, in the order the reference lists them.
+pub const RULES: &[Rule] = &[
+    FINITE,
+    POSITIVE,
+    NON_NEGATIVE,
+    SCENE_NAME,
+    DIMENSIONS,
+    SPATIAL_FORMULATION,
+    EFFECTS_MODE,
+    EFFECT_KNOWN,
+    EFFECT_ONCE,
+    STIFFENING_NEEDS_AXIAL,
+    SPATIAL_EFFECTS,
+    IN_PLANE,
+    TOLERANCE_BELOW_ONE,
+    MIN_STEP,
+    RHO_INF,
+    STOP_AFTER_START,
+    A_BEAM,
+    PART_NAME,
+    BEAM_NAMES_UNIQUE,
+    NAMES_UNIQUE,
+    AT_LEAST_ONE,
+    ELEMENTS_MAX,
+    SUBSTRUCTURES_MAX,
+    LAYOUT_MISSING,
+    LAYOUT_PER_SUBSTRUCTURE,
+    LAYOUT_EITHER,
+    RIGID_PLAIN,
+    MODES_RANGE,
+    PLANAR_ELEMENT_ONLY,
+    ONLY_3D_FIELD,
+    FROZEN_INERTIA,
+    DIRECTION,
+    NORMAL_TO_AXIS,
+    NORMAL_REQUIRED,
+    SHEAR_MODULUS,
+    MATRIX_FILE,
+    MATRIX_ONE_ELEMENT,
+    MATRIX_LENGTH,
+    SECTION_MISSING,
+    SECTION_MISSING_3D,
+    SECTION_VALUE_MISSING,
+    SECTION_3D_CONSTANTS,
+    SECTION_PLANAR_J,
+    SHAPE,
+    SHAPE_DIMENSION_UNUSED,
+    CONSTANT_FROM_SHAPE,
+    NOT_OF_RECTANGLE,
+    NOT_OF_CIRCLE,
+    HOLLOW_ONLY,
+    WALL_OF_RECTANGLE,
+    WALL_OF_CIRCLE,
+    DEFORMATION_SMALL,
+    DEFORMED_TANGENT,
+    DEFORMED_SINGLE_FRAME,
+    DEFORMED_NEEDS_FLEXIBILITY,
+    BEAM_OUTPUT,
+    BEAM_OUTPUT_3D,
+    SHAPE_POINTS,
+    BODY_INERTIA_3D,
+    PLANAR_INERTIA,
+    FRAME_NAME,
+    JOINT_FRAME,
+    JOINT_FRAMES_DIFFER,
+    SPHERICAL,
+    WELD_NO_DRIVE,
+    SPHERICAL_NO_DRIVE,
+    MOTION_CONTINUOUS,
+    LAW,
+    LAW_PARAMETER,
+    TABLE_ROWS,
+    TABLE_TIMES,
+    LOAD_FRAME,
+    LOAD_ON_BODY,
+    SCALE_NOT_INPUT,
+    PLANAR_TORQUE,
+];
+
+/// The rule of this code.
+pub fn find(code: &str) -> Option<&'static Rule> {
+    RULES.iter().find(|r| r.code == code)
+}
+
+/// Does a field of a message (`beam[2].section.A`) match a pattern of a rule
+/// (`beam[].section.A`)? `[]` matches any index, `<name>` any key, `*` anything.
+pub fn field_matches(pattern: &str, field: &str) -> bool {
+    if pattern == "*" {
+        return true;
+    }
+    let (p, f) = (pattern.as_bytes(), field.as_bytes());
+    let (mut i, mut j) = (0, 0);
+    while i < p.len() {
+        if p[i..].starts_with(b"[]") {
+            if j >= f.len() || f[j] != b'[' {
+                return false;
+            }
+            j += 1;
+            let start = j;
+            while j < f.len() && f[j].is_ascii_digit() {
+                j += 1;
+            }
+            if j == start || j >= f.len() || f[j] != b']' {
+                return false;
+            }
+            i += 2;
+            j += 1;
+        } else if p[i..].starts_with(b"<name>") {
+            let start = j;
+            while j < f.len() && (f[j].is_ascii_alphanumeric() || f[j] == b'_') {
+                j += 1;
+            }
+            if j == start {
+                return false;
+            }
+            i += 6;
+        } else {
+            if j >= f.len() || f[j] != p[i] {
+                return false;
+            }
+            i += 1;
+            j += 1;
+        }
+    }
+    j == f.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_are_unique_and_every_rule_is_listed_once() {
+        for (k, r) in RULES.iter().enumerate() {
+            assert!(
+                RULES[..k].iter().all(|o| o.code != r.code),
+                "code {} twice",
+                r.code
+            );
+        }
+    }
+
+    #[test]
+    fn the_tables_quote_the_engine_constants() {
+        let effects: Vec<&str> = crate::effects::EFFECTS.iter().map(|(n, _)| *n).collect();
+        assert_eq!(effects, EFFECT_NAMES);
+        assert!(EFFECT_KNOWN.text.ends_with(&EFFECT_NAMES.join(", ")));
+        assert!(MIN_STEP
+            .text
+            .contains(&format!("{:e} s", super::super::validate::MIN_STEP)));
+        assert!(LAW.text.ends_with(&LAWS.join(", ")));
+        assert!(SHAPE.text.ends_with(&SHAPES.join(", ")));
+        assert!(BEAM_OUTPUT
+            .text
+            .ends_with(&super::super::BEAM_OUTPUT_NAMES.join(", ")));
+        assert!(BEAM_OUTPUT_3D
+            .text
+            .ends_with(&super::super::BEAM_OUTPUT_NAMES_3D.join(", ")));
+        assert!(SHAPE_POINTS
+            .text
+            .contains(&format!("2 to {}", crate::shape::MAX_POINTS)));
+        assert!(SPATIAL_EFFECTS
+            .text
+            .ends_with(&super::super::SPATIAL_EFFECTS.join(", ")));
+        assert!(PART_NAME.text.ends_with(&RESERVED_NAMES.join(", ")));
+    }
+
+    #[test]
+    fn field_patterns_match_indices_and_names() {
+        assert!(field_matches("beam[].length", "beam[12].length"));
+        assert!(!field_matches("beam[].length", "beam[].length"));
+        assert!(!field_matches("beam[].length", "beam[0].lengths"));
+        assert!(field_matches(
+            "body[].frames.<name>[2]",
+            "body[1].frames.tip[2]"
+        ));
+        assert!(!field_matches(
+            "body[].frames.<name>[2]",
+            "body[1].frames.tip[1]"
+        ));
+        assert!(field_matches(
+            "joint[].drive.table[][]",
+            "joint[0].drive.table[3][0]"
+        ));
+        assert!(field_matches("*", "anything"));
+    }
+}
