@@ -18,6 +18,7 @@ pub mod log_categories;
 pub mod model_description;
 pub mod modes;
 pub mod package;
+pub mod platform;
 pub mod simulate;
 pub mod slave;
 pub mod template;
