@@ -23,8 +23,8 @@ SCENES  := $(wildcard scenes/*.toml)
 # its source (rust-web-src; -Zbuild-std, allowed by RUSTC_BOOTSTRAP) for the win7 variant of the
 # x86_64 windows-gnu target, linked by mingw-w64. win7: its std draws random numbers from
 # RtlGenRandom (advapi32) instead of ProcessPrng (bcryptprimitives.dll, Windows 10 on, absent
-# from Wine 8), so the DLL runs on Windows 7 to 11 and under Wine, and the binary the Wine test
-# runs is the one we ship. Its own target dir, so it can build while the Linux one does.
+# from Wine 8), so the DLL is built for Windows 7 and later and runs under Wine: the binary the
+# Wine test runs is the one we ship. Its own target dir, so it can build while the Linux one does.
 WIN64          ?= auto
 WIN64_TARGET   := x86_64-win7-windows-gnu
 WIN64_DIR      := target/win64
@@ -39,7 +39,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools win64-tools win64 release fmus demo test check bench example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools win64-tools win64 release fmus demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -129,6 +129,22 @@ bench: .venv release
 	$(HARNESS) work-precision --scenes scenes --output build/bench
 	$(HARNESS) linear-solvers --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
+
+# Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
+# and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
+# steps or tolerances (fmu-harness peer, about 6 min), both scored against the exact references
+# of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy.
+VENV_BENCH  := .venv-bench
+BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp
+$(BENCH_STAMP): requirements-bench.txt
+	$(PYTHON3) -m venv $(VENV_BENCH)
+	$(VENV_BENCH)/bin/pip install --quiet -r requirements-bench.txt
+	touch $@
+
+bench-peer: $(BENCH_STAMP) release
+	mkdir -p build/bench
+	$(VENV_BENCH)/bin/python bench/peer/sweep.py
+	$(HARNESS) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).

@@ -238,6 +238,35 @@ impl Engine {
         Ok(())
     }
 
+    /// Sets several Real variables as one fmi2SetReal call: the inputs' values first, then the
+    /// inputs that are their derivatives (a value resets its derivatives), whatever the order of
+    /// the references.
+    pub fn set_reals(&mut self, vr: &[u32], value: &[f64]) -> Result<(), EngineError> {
+        let is_derivative = |e: &Engine, r: u32| {
+            matches!(
+                e.table.get(r).map(|v| v.binding),
+                Some(Binding::InputDerivative { .. })
+            )
+        };
+        for pass in [false, true] {
+            for (&r, &v) in vr.iter().zip(value) {
+                if is_derivative(self, r) == pass {
+                    self.set_real(r, v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The index (value reference) of the variable of input slot `slot`.
+    fn input_var(&self, slot: usize) -> usize {
+        self.table
+            .variables
+            .iter()
+            .position(|v| v.binding == Binding::Input(slot))
+            .expect("every input slot has its variable")
+    }
+
     fn lookup(&self, vr: u32, ty: VarType) -> Result<usize, EngineError> {
         match self.table.get(vr) {
             Some(v) if v.ty == ty => Ok(vr as usize),
@@ -254,6 +283,10 @@ impl Engine {
         let name = var.name.clone();
         if !value.is_finite() {
             return Err(EngineError::NonFiniteValue { name, value });
+        }
+        if let Binding::InputDerivative { slot, order } = var.binding {
+            let base = self.input_var(slot) as u32;
+            return self.set_input_derivative(base, order as i32, value);
         }
         if let Binding::Input(slot) = var.binding {
             self.values[i] = value;
@@ -307,6 +340,15 @@ impl Engine {
         let i = self.lookup(vr, ty)?;
         match self.table.variables[i].binding {
             Binding::Parameter(_) | Binding::Input(_) => Ok(self.values[i]),
+            Binding::InputDerivative { slot, order } => {
+                Ok(self.input_ders[self.input_var(slot)][order as usize - 1])
+            }
+            Binding::Output(OutputKind::DriveReaction(j)) => {
+                self.built()?;
+                let m = self.model.as_mut().expect("built above");
+                let (sys, st) = (&mut m.system, &m.state);
+                (self.feedthrough).drive_reaction(sys, st, m.joint_index[j])
+            }
             Binding::Output(OutputKind::LoadFrame(load, what)) => {
                 self.built()?;
                 let m = self.model.as_mut().expect("built above");

@@ -164,20 +164,37 @@ pub fn dependencies(scene: &Scene, vars: &[Variable]) -> Vec<Vec<u32>> {
         }
     }
     let mut component = |frame: &str| owner(frame).and_then(index).map(|i| root(&mut parent, i));
-    // each input: (vr, components it acts on, is a motion input)
+    // each input: (vr, components it acts on, what it is)
+    #[derive(PartialEq)]
+    enum Acts {
+        /// A force: a load or an effort drive.
+        Force,
+        /// A motion input's value (its rate acts on nothing at a communication point).
+        Motion,
+        MotionRate,
+        /// A motion input's acceleration: acts on the accelerations as a force does.
+        MotionAcceleration,
+    }
     let slots = crate::multibody::system::input_slots(scene);
-    let mut inputs: Vec<(u32, Vec<usize>, bool)> = Vec::new();
+    let mut inputs: Vec<(u32, Vec<usize>, Acts)> = Vec::new();
     for v in vars {
-        let Binding::Input(slot) = v.binding else {
-            continue;
+        let (slot, order) = match v.binding {
+            Binding::Input(slot) => (slot, 0),
+            Binding::InputDerivative { slot, order } => (slot, order),
+            _ => continue,
         };
         let name = &slots[slot].name;
         let mut acts = Vec::new();
-        let mut motion = false;
+        let mut what = Acts::Force;
         for j in &scene.joints {
             let Some(d) = &j.drive else { continue };
             if d.law.law == "input" && name.starts_with(&format!("{}.drive.", j.name)) {
-                motion = d.kind == DriveKind::Motion;
+                if d.kind == DriveKind::Motion {
+                    what = [Acts::Motion, Acts::MotionRate, Acts::MotionAcceleration]
+                        .into_iter()
+                        .nth(order as usize)
+                        .expect("order 0, 1 or 2");
+                }
                 acts.extend(j.frames.iter().filter_map(|f| component(f)));
             }
         }
@@ -186,8 +203,19 @@ pub fn dependencies(scene: &Scene, vars: &[Variable]) -> Vec<Vec<u32>> {
                 acts.extend(component(&l.frame));
             }
         }
-        inputs.push((v.vr, acts, motion));
+        inputs.push((v.vr, acts, what));
     }
+    // the inputs that move the accelerations of component c at once
+    let accelerating = |c: Option<usize>| -> Vec<u32> {
+        inputs
+            .iter()
+            .filter(|(_, acts, what)| {
+                matches!(what, Acts::Force | Acts::MotionAcceleration)
+                    && c.is_some_and(|c| acts.contains(&c))
+            })
+            .map(|x| x.0)
+            .collect()
+    };
     vars.iter()
         .map(|v| {
             if v.causality != Causality::Output {
@@ -195,12 +223,11 @@ pub fn dependencies(scene: &Scene, vars: &[Variable]) -> Vec<Vec<u32>> {
             }
             match v.binding {
                 Binding::Output(OutputKind::LoadFrame(l, q)) if q.is_acceleration() => {
-                    let c = component(&scene.loads[l].frame);
-                    inputs
-                        .iter()
-                        .filter(|(_, acts, motion)| !motion && c.is_some_and(|c| acts.contains(&c)))
-                        .map(|x| x.0)
-                        .collect()
+                    accelerating(component(&scene.loads[l].frame))
+                }
+                Binding::Output(OutputKind::DriveReaction(j)) => {
+                    let frames = &scene.joints[j].frames;
+                    accelerating(component(&frames[1]).or_else(|| component(&frames[0])))
                 }
                 Binding::Output(OutputKind::JointEffort(j)) => {
                     let jt = &scene.joints[j];
@@ -218,9 +245,11 @@ pub fn dependencies(scene: &Scene, vars: &[Variable]) -> Vec<Vec<u32>> {
                         _ => Vec::new(),
                     }
                 }
-                Binding::Output(OutputKind::ConstraintResidual) => {
-                    inputs.iter().filter(|x| x.2).map(|x| x.0).collect()
-                }
+                Binding::Output(OutputKind::ConstraintResidual) => inputs
+                    .iter()
+                    .filter(|x| x.2 == Acts::Motion)
+                    .map(|x| x.0)
+                    .collect(),
                 _ => Vec::new(),
             }
         })
@@ -331,6 +360,23 @@ pub fn explain(scene: &Scene, table: &VariableTable) -> String {
         }
         t.push('\n');
     }
+    let motion_inputs = scene.joints.iter().any(|j| {
+        j.drive
+            .as_ref()
+            .is_some_and(|d| d.kind == DriveKind::Motion && d.law.law == "input")
+    });
+    if motion_inputs {
+        t.push_str(
+            "\nEach motion drive reading an input offers its prescribed motion's rate and \
+             acceleration as inputs of their own (<joint>.drive.speed or .velocity, \
+             <joint>.drive.acceleration: the values fmi2SetRealInputDerivatives sets; setting the \
+             motion's value resets them, and within one fmi2SetReal call values are set first) \
+             and its reaction <joint>.drive.reaction consistent with the state and the inputs as \
+             set now: d(<joint>.drive.reaction)/d(<joint>.drive.acceleration) is the interface's \
+             effective inertia (mass), what a master coupling in motion causality needs. \
+             <joint>.torque or .force stays the reaction of the last step.\n",
+        );
+    }
     t.push_str(
         "\nsolver.next_event_time is the next time where a drive or load law jumps (the unit \
          lands there and restarts its integrator); a master joining units mechanically lands \
@@ -400,6 +446,8 @@ pub struct Feedthrough {
     /// (t, q, q', inputs) of `qdd`.
     accel_at: Option<AccelKey>,
     qdd: DVector<f64>,
+    /// The multipliers that go with `qdd`.
+    lambda: DVector<f64>,
 }
 
 impl Feedthrough {
@@ -460,6 +508,7 @@ impl Feedthrough {
         rhs.rows_mut(n, m).copy_from(&(-bias));
         let x = self.solve(&rhs, st.t)?;
         self.qdd = x.rows(0, n).into_owned();
+        self.lambda = x.rows(n, m).into_owned();
         self.accel_at = Some((st.t, st.q.clone(), st.v.clone(), sys.inputs().to_vec()));
         Ok(())
     }
@@ -480,6 +529,18 @@ impl Feedthrough {
         Ok(frame_value(sys, st, &self.qdd, f, what))
     }
 
+    /// The reaction of the motion drive of system joint `j`, consistent with the state and the
+    /// inputs as set now (the multiplier of the acceleration-level solve, not the last step's).
+    pub fn drive_reaction(
+        &mut self,
+        sys: &mut Mechanics,
+        st: &GaState,
+        j: usize,
+    ) -> Result<f64, EngineError> {
+        self.accelerations(sys, st)?;
+        Ok(joint_effort(sys, j, &self.lambda, just_after(st.t)))
+    }
+
     /// Σ_j ∂y_i/∂u_j dv_j for each unknown y_i (references checked by [`check_references`]).
     #[allow(clippy::too_many_arguments)]
     pub fn directional_derivative(
@@ -497,30 +558,54 @@ impl Feedthrough {
         for u in sys.inputs_mut().iter_mut() {
             u.t0 = te;
         }
+        // a derivative input (rate, acceleration of a motion input) reads as slot 0 here: it
+        // matches no law `Input(slot)` of its own, and only `accelerations_by` uses it
         let slot = |vr: u32| match table.get(vr).map(|v| v.binding) {
             Some(Binding::Input(s)) => s,
+            Some(Binding::InputDerivative { .. }) => usize::MAX,
             _ => unreachable!("checked: knowns are inputs"),
         };
         let needs_accel = unknowns.iter().any(|&vr| {
             matches!(
                 table.get(vr).map(|v| v.binding),
                 Some(Binding::Output(OutputKind::LoadFrame(_, q))) if q.is_acceleration()
+            ) || matches!(
+                table.get(vr).map(|v| v.binding),
+                Some(Binding::Output(OutputKind::DriveReaction(_)))
             )
         });
-        // ∂q'' along dv
-        let mut dqdd = DVector::zeros(sys.n());
+        // ∂q'', ∂λ along dv
+        let (n, m) = (sys.n(), sys.m());
+        let mut dqdd = DVector::zeros(n);
+        let mut dlambda = DVector::zeros(m);
         if needs_accel {
-            let (n, m) = (sys.n(), sys.m());
             let mut rhs = DVector::zeros(n + m);
             for (&vr, &d) in knowns.iter().zip(dv) {
-                if d != 0.0 {
-                    for (k, x) in input_force(sys, st, te, slot(vr)) {
-                        rhs[k] += x * d;
+                if d == 0.0 {
+                    continue;
+                }
+                match table.get(vr).map(|v| v.binding) {
+                    Some(Binding::Input(s)) => {
+                        for (k, x) in input_force(sys, st, te, s) {
+                            rhs[k] += x * d;
+                        }
                     }
+                    Some(Binding::InputDerivative { slot: s, order: 2 }) => {
+                        for (row, law) in motion_rows(sys) {
+                            if law.law == Law::Input(s) {
+                                // g'' = G q'' + bias_q − law'': the row's right side is +law''
+                                rhs[n + row] += law.eval(te, &second(sys, s, te)).2 * d;
+                            }
+                        }
+                    }
+                    // the rate does not act at the communication point: the state's velocity does
+                    _ => {}
                 }
             }
             self.factorize(sys, st)?;
-            dqdd = self.solve(&rhs, st.t)?.rows(0, n).into_owned();
+            let x = self.solve(&rhs, st.t)?;
+            dqdd = x.rows(0, n).into_owned();
+            dlambda = x.rows(n, m).into_owned();
         }
         let unit = |s: usize| {
             let mut u = vec![InputValue::default(); sys.inputs().len()];
@@ -560,6 +645,8 @@ impl Feedthrough {
                 OutputKind::ConstraintResidual => {
                     residual_derivative(sys, st, knowns, dv, slot, &unit)
                 }
+                // linear in λ (a motion drive's effort is −λ of its row)
+                OutputKind::DriveReaction(j) => joint_effort(sys, joint_index[j], &dlambda, te),
                 _ => 0.0,
             };
             out.push(d);
@@ -594,21 +681,7 @@ fn residual_derivative(
     let mut g = DVector::zeros(m);
     sys.constraints(&st.q, st.t, &mut g);
     let mut dg: DVector<f64> = DVector::zeros(m);
-    let joints = match sys {
-        Mechanics::Planar(s, _) => s.joints.len(),
-        Mechanics::Spatial(s, _) => s.joints.len(),
-    };
-    for j in 0..joints {
-        let Some((DriveKind::Motion, law)) = drive_of(sys, j) else {
-            continue;
-        };
-        let row = match sys {
-            Mechanics::Planar(s, _) => {
-                let jt = &s.joints[j];
-                jt.row + crate::multibody::joint::Joint::rows_count(jt.kind, jt.drive.as_ref()) - 1
-            }
-            Mechanics::Spatial(s, _) => s.joint_row(j) + s.joints[j].len() - 1,
-        };
+    for (row, law) in motion_rows(sys) {
         for (&vr, &d) in knowns.iter().zip(dv) {
             if law.law == Law::Input(slot(vr)) {
                 dg[row] -= law.eval(st.t, &unit(slot(vr))).0 * d;
@@ -626,6 +699,52 @@ fn residual_derivative(
             }
         })
         .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The constraint row and law of each motion drive (the drive's row is its joint's last).
+fn motion_rows(sys: &Mechanics) -> Vec<(usize, &crate::multibody::law::TimeLaw)> {
+    let joints = match sys {
+        Mechanics::Planar(s, _) => s.joints.len(),
+        Mechanics::Spatial(s, _) => s.joints.len(),
+    };
+    (0..joints)
+        .filter_map(|j| {
+            let Some((DriveKind::Motion, law)) = drive_of(sys, j) else {
+                return None;
+            };
+            let row = match sys {
+                Mechanics::Planar(s, _) => {
+                    let jt = &s.joints[j];
+                    jt.row + crate::multibody::joint::Joint::rows_count(jt.kind, jt.drive.as_ref())
+                        - 1
+                }
+                Mechanics::Spatial(s, _) => s.joint_row(j) + s.joints[j].len() - 1,
+            };
+            Some((row, law))
+        })
+        .collect()
+}
+
+/// Inputs with a unit second derivative in slot `s` at t and nothing else: a law reading the
+/// slot returns its coefficient on the input's acceleration as its own second derivative.
+fn second(sys: &Mechanics, s: usize, t: f64) -> Vec<InputValue> {
+    let mut u = vec![InputValue::default(); sys.inputs().len()];
+    u[s] = InputValue {
+        value: 0.0,
+        der1: 0.0,
+        der2: 1.0,
+        t0: t,
+    };
+    u
+}
+
+/// The effort of system joint `j`'s drive with multipliers `lambda` (a motion drive's: −λ of
+/// its row).
+fn joint_effort(sys: &Mechanics, j: usize, lambda: &DVector<f64>, t: f64) -> f64 {
+    match sys {
+        Mechanics::Planar(s, _) => s.joint_effort(j, lambda, t),
+        Mechanics::Spatial(s, _) => s.joint_effort(j, lambda, t),
+    }
 }
 
 /// ∂Q/∂u of one input slot at time t, as (coordinate, value) pairs.

@@ -125,6 +125,9 @@ pub enum OutputKind {
     JointCoordinate(usize),
     JointRate(usize),
     JointEffort(usize),
+    /// The reaction of a motion drive reading an input (scene joint index), consistent with
+    /// the state and the inputs as set now: depends directly on the input's acceleration.
+    DriveReaction(usize),
     /// Pose of a rigid body (scene body index).
     BodyX(usize),
     BodyY(usize),
@@ -158,6 +161,12 @@ pub enum Binding {
     Output(OutputKind),
     /// FMU input in this slot of `multibody::system::input_slots`.
     Input(usize),
+    /// The first or second time derivative (`order` 1 or 2) of the motion input in `slot`, as
+    /// an input of its own: the same value fmi2SetRealInputDerivatives sets.
+    InputDerivative {
+        slot: usize,
+        order: u8,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -505,7 +514,7 @@ impl VariableTable {
             .enumerate()
         {
             t.push(
-                input.name,
+                input.name.clone(),
                 VarType::Real,
                 C::Input,
                 V::Continuous,
@@ -514,6 +523,7 @@ impl VariableTable {
                 Some(input.start),
                 Binding::Input(slot),
             );
+            motion_interface(&mut t, scene, slot, &input.name);
         }
         for (i, (b, fx)) in scene.beams.iter().zip(&effects.beams).enumerate() {
             for o in scene.beam_outputs(b) {
@@ -866,4 +876,53 @@ impl Builder {
             Binding::Output(kind),
         );
     }
+}
+
+/// The motion interface of a motion drive reading input `slot` (named `name`): its rate and
+/// acceleration as inputs of their own, and its reaction consistent with them, so that a master
+/// coupling in motion causality reads the interface's effective inertia as
+/// d(reaction)/d(acceleration) (fmi2GetDirectionalDerivative). Nothing for other inputs.
+fn motion_interface(t: &mut Builder, scene: &Scene, slot: usize, name: &str) {
+    use crate::scene::{DriveKind, JointKind};
+    let Some((j, joint)) = scene.joints.iter().enumerate().find(|(_, j)| {
+        j.drive
+            .as_ref()
+            .is_some_and(|d| d.kind == DriveKind::Motion && d.law.law == "input")
+            && name.starts_with(&format!("{}.drive.", j.name))
+    }) else {
+        return;
+    };
+    let n = &joint.name;
+    let (rate, units, effort) = if joint.kind == JointKind::Prismatic {
+        ("velocity", ["m/s", "m/s2", "N"], "force")
+    } else {
+        ("speed", ["rad/s", "rad/s2", "N.m"], "torque")
+    };
+    for (order, what, unit) in [(1u8, rate, units[0]), (2, "acceleration", units[1])] {
+        t.push(
+            format!("{n}.drive.{what}"),
+            VarType::Real,
+            Causality::Input,
+            Variability::Continuous,
+            Some(unit),
+            &format!(
+                "Drive of joint {n}: the prescribed motion's {what}, the time derivative of \
+                 order {order} of {name} over the next step (the value fmi2SetRealInputDerivatives \
+                 sets; setting {name} resets it to 0, so set it after {name})"
+            ),
+            Some(0.0),
+            Binding::InputDerivative { slot, order },
+        );
+    }
+    t.output(
+        format!("{n}.drive.reaction"),
+        VarType::Real,
+        Some(units[2]),
+        &format!(
+            "Reaction {effort} of the drive of joint {n} on frame 1, consistent with the state and \
+             the inputs as set now (direct feedthrough of {n}.drive.acceleration: its derivative \
+             is the interface's effective inertia); {n}.{effort} is the last step's"
+        ),
+        OutputKind::DriveReaction(j),
+    );
 }

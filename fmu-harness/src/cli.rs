@@ -204,7 +204,11 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                     &mut progress,
                 )?)
             };
-            let header = work_precision::header(&options, started.elapsed().as_secs_f64());
+            let header = format!(
+                "{}\n\n{}",
+                work_precision::header(&options, started.elapsed().as_secs_f64()),
+                work_precision::overhead::table(&scenes, 5)?
+            );
             for path in work_precision::report::write(&output, &results, spatial.as_ref(), &header)?
             {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;

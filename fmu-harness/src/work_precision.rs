@@ -11,6 +11,7 @@
 
 pub mod cases;
 pub mod exact;
+pub mod overhead;
 pub mod peer;
 pub mod report;
 pub mod spatial;

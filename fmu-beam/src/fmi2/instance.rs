@@ -187,10 +187,7 @@ impl Instance {
     }
 
     pub fn set_real(&mut self, vr: &[u32], value: &[f64]) -> Result<(), Fault> {
-        for (&r, &v) in vr.iter().zip(value) {
-            self.engine.set_real(r, v).map_err(|e| self.fail(e))?;
-        }
-        Ok(())
+        self.engine.set_reals(vr, value).map_err(|e| self.fail(e))
     }
 
     pub fn set_integer(&mut self, vr: &[u32], value: &[i32]) -> Result<(), Fault> {
