@@ -1,5 +1,9 @@
 # fmu-beam: build the engine and the packager, package every scene, test, demo, bench.
 # `make demo` and `make test` are the two commands of the README; `make check` is what CI runs.
+# Every FMU carries binaries/linux64/<id>.so and, where the Windows toolchain is installed
+# (`make win64-tools`), binaries/win64/<id>.dll. WIN64=auto (default) builds the Windows engine
+# when the toolchain is there and says so when it is not; WIN64=0 never builds it (a quicker
+# edit-test loop); WIN64=1 requires it (fails without the toolchain).
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
@@ -14,7 +18,28 @@ HARNESS := target/release/fmu-harness
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
-.PHONY: .venv tools browser release fmus docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
+# The Windows engine: Debian's second Rust (rustc-web, cargo-web: 1.96, in /usr/bin beside
+# rustup's, which stays first on PATH, so called by full path) builds the standard library from
+# its source (rust-web-src; -Zbuild-std, allowed by RUSTC_BOOTSTRAP) for the win7 variant of the
+# x86_64 windows-gnu target, linked by mingw-w64. win7: its std draws random numbers from
+# RtlGenRandom (advapi32) instead of ProcessPrng (bcryptprimitives.dll, Windows 10 on, absent
+# from Wine 8), so the DLL is built for Windows 7 and later and runs under Wine: the binary the
+# Wine test runs is the one we ship. Its own target dir, so it can build while the Linux one does.
+WIN64          ?= auto
+WIN64_TARGET   := x86_64-win7-windows-gnu
+WIN64_DIR      := target/win64
+WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
+WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
+WIN64_TEST_PACKAGES := wine64
+WIN64_BUILD    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
+  CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
+  nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+# Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
+WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/dev/null | grep -c 'install ok installed')" == $(words $(WIN64_PACKAGES)) ]]
+WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
+ \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
+
+.PHONY: .venv tools browser win64-tools win64 release fmus docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -34,21 +59,48 @@ browser:
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || { \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
 
+# The Windows build's tools (and Wine, for its test), from Debian, when missing. A machine where
+# they cannot be installed (not Debian, not root, no registry) goes on without them.
+win64-tools:
+	@[[ "$(WIN64)" == 0 ]] && exit 0; \
+	if ! $(WIN64_READY) || ! command -v wine >/dev/null; then \
+	  echo "win64-tools: installing $(WIN64_PACKAGES) $(WIN64_TEST_PACKAGES) from Debian"; \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      $(WIN64_PACKAGES) $(WIN64_TEST_PACKAGES) >/dev/null; } \
+	  || echo "win64-tools: could not install them" >&2; \
+	fi
+
 release:
 	cargo build --release --workspace
 
-# Every scene as build/fmus/<stem>.fmu. All scenes are tried; a scene that fails leaves no
-# (stale) FMU behind and fails the target. FMUs of scenes that no longer exist are removed.
-fmus: release
+# The Windows engine ($(WIN64_ENGINE)), when the toolchain is there; about 5 minutes from clean
+# on 2 cores (the standard library is built too), seconds when up to date. Waits for a build
+# already running in $(WIN64_DIR) (cargo's lock), e.g. the one `make test` starts.
+win64:
+	@if [[ "$(WIN64)" == 0 ]]; then exit 0; fi; \
+	if $(WIN64_READY); then \
+	  $(WIN64_BUILD); \
+	elif [[ "$(WIN64)" == 1 ]]; then \
+	  $(WIN64_MISSING); echo "win64: WIN64=1 requires it" >&2; exit 1; \
+	else \
+	  $(WIN64_MISSING); \
+	fi
+
+# Every scene as build/fmus/<stem>.fmu, with the Linux engine and (see win64) the Windows one.
+# All scenes are tried; a scene that fails leaves no (stale) FMU behind and fails the target.
+# FMUs of scenes that no longer exist are removed.
+fmus: release win64
 	mkdir -p build/fmus
 	for f in build/fmus/*.fmu; do \
 	  [[ -e "$$f" ]] || continue; \
 	  [[ -e "scenes/$$(basename "$$f" .fmu).toml" ]] || rm -f "$$f"; \
 	done
+	binaries=(--binary linux64=$(ENGINE)); \
+	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then binaries+=(--binary win64=$(WIN64_ENGINE)); fi; \
 	failed=(); \
 	for s in $(SCENES); do \
 	  out="build/fmus/$$(basename "$$s" .toml).fmu"; \
-	  $(HARNESS) package "$$s" -o "$$out" --binary $(ENGINE) || { rm -f "$$out"; failed+=("$$s"); }; \
+	  $(HARNESS) package "$$s" -o "$$out" "$${binaries[@]}" || { rm -f "$$out"; failed+=("$$s"); }; \
 	done; \
 	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
 
@@ -63,9 +115,18 @@ demo: .venv fmus
 	$(PY) tests/demo.py
 	$(PY) tests/demo_animations.py
 
-test: .venv tools browser fmus
+# The Windows engine builds in the background (log: build/win64/build.log) while the Linux
+# build and the Rust tests run; `fmus` then waits for it (cargo's lock on $(WIN64_DIR)).
+test: .venv tools browser win64-tools
+	@mkdir -p build/win64; \
+	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
+	  echo "win64: building the Windows engine in the background (build/win64/build.log)"; \
+	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
+	fi
+	$(MAKE) --no-print-directory release
 	cargo test --workspace --release --no-fail-fast
-	$(PY) -m pytest tests -q
+	$(MAKE) --no-print-directory fmus
+	WIN64=$(WIN64) $(PY) -m pytest tests -q
 
 check:
 	cargo fmt --all --check

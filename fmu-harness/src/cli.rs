@@ -29,10 +29,13 @@ pub enum Command {
         /// The FMU to write, e.g. build/fmus/<scene>.fmu.
         #[arg(short, long)]
         output: PathBuf,
-        /// The engine library to embed [default: target/release/libfmu_beam.so of this
-        /// executable's target directory, else the one beside this executable].
+        /// An engine library to embed, one per platform: `[PLATFORM=]PATH`, e.g.
+        /// `--binary target/release/libfmu_beam.so --binary win64=fmu_beam.dll`; the platform
+        /// (linux64, win64) is read from the file's header and must agree with the one named
+        /// [default: target/release/libfmu_beam.so of this executable's target directory, else
+        /// the one beside this executable; Linux only].
         #[arg(long)]
-        binary: Option<PathBuf>,
+        binary: Vec<package::BinaryArg>,
     },
     /// Print the effects the scene's unit simulates, why, and their estimated share of the
     /// cost (the text the FMU carries in documentation/).
@@ -208,15 +211,20 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             output,
             binary,
         } => {
-            let p = package::package(&scene, &output, binary.as_deref())?;
+            let p = package::package(&scene, &output, &binary)?;
+            let engines: Vec<String> = p
+                .binaries
+                .iter()
+                .map(|(platform, path)| format!("{platform} {}", path.display()))
+                .collect();
             writeln!(
                 out,
-                "{}: {} ({} variables, GUID {}, engine {})",
+                "{}: {} ({} variables, GUID {}, engines: {})",
                 p.output.display(),
                 p.model_identifier,
                 p.variables,
                 p.guid,
-                p.binary.display()
+                engines.join(", ")
             )
             .map_err(stdout_err)?;
         }

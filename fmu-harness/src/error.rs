@@ -1,5 +1,6 @@
 //! Everything that can go wrong in the harness, with the path or the numbers that explain it.
 
+use crate::platform::Platform;
 use fmu_beam::scene::SceneError;
 use fmu_beam::EngineError;
 use std::path::PathBuf;
@@ -18,6 +19,26 @@ pub enum HarnessError {
         .searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
     )]
     BinaryNotFound { searched: Vec<PathBuf> },
+    #[error(
+        "{}: {}",
+        .path.display(),
+        binary_platform_message(*.named, *.found)
+    )]
+    BinaryPlatform {
+        path: PathBuf,
+        named: Option<Platform>,
+        found: Option<Platform>,
+    },
+    #[error(
+        "two engine libraries for {platform}: {} and {}; give one per platform",
+        .first.display(),
+        .second.display()
+    )]
+    DuplicatePlatform {
+        platform: Platform,
+        first: PathBuf,
+        second: PathBuf,
+    },
     #[error("{}: {action}: {source}", .path.display())]
     Io {
         path: PathBuf,
@@ -54,6 +75,26 @@ pub enum HarnessError {
     Input { origin: String, message: String },
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
     BadOutput { path: PathBuf },
+}
+
+/// Why a `--binary` cannot go under its platform's folder.
+fn binary_platform_message(named: Option<Platform>, found: Option<Platform>) -> String {
+    match (named, found) {
+        (Some(named), Some(found)) => format!(
+            "given as the {named} engine, but it is {} (a {found} library)",
+            found.library_kind()
+        ),
+        _ => {
+            let known: Vec<String> = Platform::ALL
+                .iter()
+                .map(|p| format!("{p}: {}", p.library_kind()))
+                .collect();
+            format!(
+                "not an engine library of a platform the packager fills ({})",
+                known.join("; ")
+            )
+        }
+    }
 }
 
 impl HarnessError {

@@ -19,6 +19,7 @@ pub mod log_categories;
 pub mod model_description;
 pub mod modes;
 pub mod package;
+pub mod platform;
 pub mod reference;
 pub mod schema;
 pub mod simulate;

@@ -1,22 +1,57 @@
 //! `fmu-harness package`: a scene file → an FMI 2.0 co-simulation FMU.
 //!
-//! Layout of the FMU: `modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so` (the
-//! engine cdylib under the scene's name), `resources/scene.toml` (the canonical scene text the
-//! engine reads in fmi2Instantiate) and `resources/guid.txt` (checked there against fmuGUID).
+//! Layout of the FMU: `modelDescription.xml`, one engine library per platform under the
+//! scene's name (`binaries/linux64/<modelIdentifier>.so`, `binaries/win64/<modelIdentifier>.dll`),
+//! `resources/scene.toml` (the canonical scene text the engine reads in fmi2Instantiate),
+//! `resources/guid.txt` (checked there against fmuGUID) and `documentation/index.html`.
 
 use crate::archive::{self, Entry};
 use crate::error::HarnessError;
 use crate::guid::guid;
 use crate::model_description;
+use crate::platform::Platform;
 use fmu_beam::variables::VariableTable;
 use fmu_beam::Scene;
 use std::path::{Path, PathBuf};
 
-/// File name of the engine cdylib that cargo builds.
+/// File name of the engine cdylib that cargo builds for Linux.
 pub const ENGINE_LIBRARY: &str = "libfmu_beam.so";
 
-/// Platform folder of x86_64 Linux binaries in an FMI 2.0 FMU.
-pub const PLATFORM: &str = "linux64";
+/// One `--binary` of `fmu-harness package`: `[PLATFORM=]PATH`, the platform named or (None)
+/// read from the library's header.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BinaryArg {
+    pub platform: Option<Platform>,
+    pub path: PathBuf,
+}
+
+impl std::str::FromStr for BinaryArg {
+    type Err = String;
+
+    /// `linux64=target/release/libfmu_beam.so`, `win64=fmu_beam.dll` or a bare path. A prefix
+    /// that looks like a platform folder but is none the packager knows is refused.
+    fn from_str(text: &str) -> Result<BinaryArg, String> {
+        if let Some((head, path)) = text.split_once('=') {
+            if let Some(platform) = Platform::from_folder(head) {
+                return Ok(BinaryArg {
+                    platform: Some(platform),
+                    path: PathBuf::from(path),
+                });
+            }
+            if !head.is_empty() && head.chars().all(|c| c.is_ascii_alphanumeric()) {
+                let known: Vec<&str> = Platform::ALL.iter().map(|p| p.folder()).collect();
+                return Err(format!(
+                    "unknown platform '{head}' (the packager fills {})",
+                    known.join(", ")
+                ));
+            }
+        }
+        Ok(BinaryArg {
+            platform: None,
+            path: PathBuf::from(text),
+        })
+    }
+}
 
 /// What a packaging run produced.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,7 +60,8 @@ pub struct Packaged {
     pub model_identifier: String,
     pub guid: String,
     pub variables: usize,
-    pub binary: PathBuf,
+    /// The engine library packaged for each platform, in [`Platform::ALL`] order.
+    pub binaries: Vec<(Platform, PathBuf)>,
 }
 
 /// The files of an FMU, before zipping.
@@ -41,12 +77,26 @@ pub struct FmuContents {
     pub variables: usize,
 }
 
-/// modelDescription.xml, scene text and GUID of a scene packaged with the given engine binary.
-pub fn contents(scene: &Scene, binary: &[u8]) -> Result<FmuContents, HarnessError> {
+/// modelDescription.xml, scene text and GUID of a scene packaged with the given engine
+/// binaries. The GUID digests the unsigned XML, the scene text and, for each platform in order,
+/// its folder name, the binary's length (u64 little-endian) and bytes: any change of any binary
+/// changes it, and so does moving bytes from one binary to another.
+pub fn contents(
+    scene: &Scene,
+    binaries: &[(Platform, &[u8])],
+) -> Result<FmuContents, HarnessError> {
     let table = VariableTable::build(scene);
     let scene_text = canonical_text(scene)?;
     let unsigned = model_description::render(scene, &table, "")?;
-    let guid = guid(&[unsigned.as_bytes(), scene_text.as_bytes(), binary]);
+    let lengths: Vec<[u8; 8]> = binaries
+        .iter()
+        .map(|(_, b)| (b.len() as u64).to_le_bytes())
+        .collect();
+    let mut parts: Vec<&[u8]> = vec![unsigned.as_bytes(), scene_text.as_bytes()];
+    for ((platform, bytes), length) in binaries.iter().zip(&lengths) {
+        parts.extend([platform.folder().as_bytes(), &length[..], bytes]);
+    }
+    let guid = guid(&parts);
     let model_description = model_description::render(scene, &table, &guid)?;
     Ok(FmuContents {
         model_identifier: scene.name.clone(),
@@ -138,57 +188,105 @@ fn canonical_text(scene: &Scene) -> Result<String, HarnessError> {
     }
 }
 
-/// Loads the scene, builds the FMU and writes it to `output` (atomically).
+/// Loads the scene, builds the FMU with one engine library per platform (without `binaries`,
+/// the Linux engine of [`default_binary`]) and writes it to `output` (atomically). Each
+/// library's platform is read from its header; one named in `binaries` must agree with it, and
+/// a platform may come only once.
 pub fn package(
     scene_path: &Path,
     output: &Path,
-    binary: Option<&Path>,
+    binaries: &[BinaryArg],
 ) -> Result<Packaged, HarnessError> {
     let scene = Scene::load(scene_path)?;
-    let binary = match binary {
-        Some(b) => b.to_path_buf(),
-        None => default_binary()?,
+    let given = if binaries.is_empty() {
+        vec![BinaryArg {
+            platform: None,
+            path: default_binary()?,
+        }]
+    } else {
+        binaries.to_vec()
     };
-    let lib = std::fs::read(&binary)
-        .map_err(|e| HarnessError::io(&binary, "reading the engine library", e))?;
-    let c = contents(&scene, &lib)?;
-    let so_path = format!("binaries/{PLATFORM}/{}.so", c.model_identifier);
-    archive::write_fmu(
-        output,
-        &[
-            Entry {
-                path: "modelDescription.xml",
-                data: c.model_description.as_bytes(),
-                mode: 0o644,
-            },
-            Entry {
-                path: &so_path,
-                data: &lib,
-                mode: 0o755,
-            },
-            Entry {
-                path: "resources/scene.toml",
-                data: c.scene_text.as_bytes(),
-                mode: 0o644,
-            },
-            Entry {
-                path: "resources/guid.txt",
-                data: c.guid.as_bytes(),
-                mode: 0o644,
-            },
-            Entry {
-                path: "documentation/index.html",
-                data: c.documentation.as_bytes(),
-                mode: 0o644,
-            },
-        ],
-    )?;
+    let mut libraries: Vec<(Platform, PathBuf, Vec<u8>)> = Vec::new();
+    for arg in given {
+        let bytes = std::fs::read(&arg.path)
+            .map_err(|e| HarnessError::io(&arg.path, "reading the engine library", e))?;
+        let found = Platform::of_library(&bytes);
+        let platform = match (arg.platform, found) {
+            (Some(named), Some(found)) if named == found => found,
+            (None, Some(found)) => found,
+            (named, found) => {
+                return Err(HarnessError::BinaryPlatform {
+                    path: arg.path,
+                    named,
+                    found,
+                })
+            }
+        };
+        if let Some((_, first, _)) = libraries.iter().find(|(p, _, _)| *p == platform) {
+            return Err(HarnessError::DuplicatePlatform {
+                platform,
+                first: first.clone(),
+                second: arg.path,
+            });
+        }
+        libraries.push((platform, arg.path, bytes));
+    }
+    libraries.sort_by_key(|(p, _, _)| *p);
+    let parts: Vec<(Platform, &[u8])> = libraries
+        .iter()
+        .map(|(p, _, b)| (*p, b.as_slice()))
+        .collect();
+    let c = contents(&scene, &parts)?;
+    let paths: Vec<String> = libraries
+        .iter()
+        .map(|(p, _, _)| {
+            format!(
+                "binaries/{}/{}.{}",
+                p.folder(),
+                c.model_identifier,
+                p.extension()
+            )
+        })
+        .collect();
+    let mut entries = vec![Entry {
+        path: "modelDescription.xml",
+        data: c.model_description.as_bytes(),
+        mode: 0o644,
+    }];
+    for (path, (_, _, bytes)) in paths.iter().zip(&libraries) {
+        entries.push(Entry {
+            path,
+            data: bytes,
+            mode: 0o755,
+        });
+    }
+    entries.extend([
+        Entry {
+            path: "resources/scene.toml",
+            data: c.scene_text.as_bytes(),
+            mode: 0o644,
+        },
+        Entry {
+            path: "resources/guid.txt",
+            data: c.guid.as_bytes(),
+            mode: 0o644,
+        },
+        Entry {
+            path: "documentation/index.html",
+            data: c.documentation.as_bytes(),
+            mode: 0o644,
+        },
+    ]);
+    archive::write_fmu(output, &entries)?;
     Ok(Packaged {
         output: output.to_path_buf(),
         model_identifier: c.model_identifier,
         guid: c.guid,
         variables: c.variables,
-        binary,
+        binaries: libraries
+            .into_iter()
+            .map(|(p, path, _)| (p, path))
+            .collect(),
     })
 }
 
@@ -231,8 +329,37 @@ pub fn binary_candidates(exe: &Path) -> Vec<PathBuf> {
 
 #[cfg(test)]
 mod tests {
-    use super::binary_candidates;
+    use super::{binary_candidates, BinaryArg};
+    use crate::platform::Platform;
     use std::path::{Path, PathBuf};
+
+    #[test]
+    fn binary_arguments_name_a_platform_or_only_a_path() {
+        let arg = |s: &str| s.parse::<BinaryArg>();
+        let named = |p, path: &str| BinaryArg {
+            platform: Some(p),
+            path: PathBuf::from(path),
+        };
+        assert_eq!(
+            arg("win64=target/a=b.dll"),
+            Ok(named(Platform::Win64, "target/a=b.dll"))
+        );
+        assert_eq!(
+            arg("linux64=lib.so"),
+            Ok(named(Platform::Linux64, "lib.so"))
+        );
+        assert_eq!(
+            arg("target/release/libfmu_beam.so"),
+            Ok(BinaryArg {
+                platform: None,
+                path: PathBuf::from("target/release/libfmu_beam.so")
+            })
+        );
+        assert_eq!(arg("./a=b.so").unwrap().path, PathBuf::from("./a=b.so"));
+        assert!(arg("darwin64=x.dylib")
+            .unwrap_err()
+            .contains("unknown platform 'darwin64'"));
+    }
 
     #[test]
     fn engine_library_is_looked_for_in_release_then_beside_the_executable() {

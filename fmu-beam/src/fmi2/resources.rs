@@ -4,11 +4,21 @@
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
-/// The directory named by `fmuResourceLocation`.
-///
-/// Accepted: `file:///abs/path`, `file:/abs/path`, `file://localhost/abs/path`, with or without
-/// a trailing slash, percent-encoded (`%20`); also a bare absolute path, taken literally.
+/// The directory named by `fmuResourceLocation`, read as this platform reads paths
+/// ([`directory_text`] with `windows = cfg!(windows)`).
 pub fn directory(location: &str) -> Result<PathBuf, String> {
+    directory_text(location, cfg!(windows)).map(PathBuf::from)
+}
+
+/// The path text of the directory named by `fmuResourceLocation`.
+///
+/// Accepted everywhere: `file:///abs/path`, `file:/abs/path`, `file://localhost/abs/path`, with
+/// or without a trailing slash, percent-encoded (`%20`); also a bare absolute path, taken
+/// literally. With `windows` (what masters on Windows send): a drive letter after the URI's
+/// slash (`file:///C:/dir` → `C:/dir`, also `file://C:/dir`), a host as a network share
+/// (`file://server/share/dir` → `//server/share/dir`), and bare `C:\dir` or `\\server\share`
+/// paths.
+pub fn directory_text(location: &str, windows: bool) -> Result<String, String> {
     let refuse = |why: &str| {
         format!(
             "fmuResourceLocation '{location}' {why}; expected a file URI such as \
@@ -22,28 +32,59 @@ pub fn directory(location: &str) -> Result<PathBuf, String> {
                     .find('/')
                     .unwrap_or(authority_and_path.len());
                 let (host, path) = authority_and_path.split_at(slash);
-                if !(host.is_empty() || host.eq_ignore_ascii_case("localhost")) {
+                let path = if host.is_empty() || host.eq_ignore_ascii_case("localhost") {
+                    path.to_string()
+                } else if windows && is_drive(host) {
+                    format!("/{host}{path}")
+                } else if windows {
+                    format!("//{host}{path}")
+                } else {
                     return Err(refuse(&format!(
                         "names the host '{host}': only local files can be read"
                     )));
-                }
+                };
                 if path.is_empty() {
                     return Err(refuse("has no path"));
                 }
-                percent_decode(path).map_err(|e| refuse(&e))?
+                percent_decode(&path).map_err(|e| refuse(&e))?
             }
             None if rest.starts_with('/') => percent_decode(rest).map_err(|e| refuse(&e))?,
             None => return Err(refuse("is not an absolute path")),
         },
         None if location.starts_with('/') => location.to_string(),
+        None if windows && (location.starts_with('\\') || starts_with_drive(location)) => {
+            location.to_string()
+        }
         None => return Err(refuse("is not a file URI")),
     };
-    let trimmed = path.trim_end_matches('/');
-    Ok(PathBuf::from(if trimmed.is_empty() {
-        "/"
+    // `/C:/dir` is a URI's path of `C:/dir`; only Windows has drive letters
+    let path = match path.strip_prefix('/') {
+        Some(rest) if windows && starts_with_drive(rest) => rest,
+        _ => path.as_str(),
+    };
+    let trimmed = if windows {
+        path.trim_end_matches(['/', '\\'])
     } else {
-        trimmed
-    }))
+        path.trim_end_matches('/')
+    };
+    Ok(if trimmed.is_empty() {
+        "/".to_string()
+    } else if windows && is_drive(trimmed) {
+        format!("{trimmed}/")
+    } else {
+        trimmed.to_string()
+    })
+}
+
+/// `C:` (a drive letter and a colon, nothing more).
+fn is_drive(s: &str) -> bool {
+    let b = s.as_bytes();
+    b.len() == 2 && b[0].is_ascii_alphabetic() && b[1] == b':'
+}
+
+/// `C:`, then the end or a slash or backslash.
+fn starts_with_drive(s: &str) -> bool {
+    s.get(..2).is_some_and(is_drive) && matches!(s.as_bytes().get(2), None | Some(b'/' | b'\\'))
 }
 
 fn strip_prefix_ignore_case<'a>(s: &'a str, prefix: &str) -> Option<&'a str> {
@@ -108,5 +149,35 @@ mod tests {
         assert!(p("http://x/a").is_err());
         assert!(p("file:///a/%zz").unwrap_err().contains("percent escape"));
         assert!(p("file:///a/%2").is_err());
+    }
+
+    /// What masters on Windows send (fmpy: `Path.as_uri()`, `file:///C:/...`), read as Windows
+    /// reads it; on Linux the same texts are refused or stay Unix paths.
+    #[test]
+    fn windows_uri_forms() {
+        let w = |s: &str| directory_text(s, true);
+        let ok = |s: &str| Ok::<String, String>(s.to_string());
+        assert_eq!(
+            w("file:///C:/Users/a%20b/fmu/resources/"),
+            ok("C:/Users/a b/fmu/resources")
+        );
+        assert_eq!(w("file:/c:/fmu/resources"), ok("c:/fmu/resources"));
+        assert_eq!(w("file://localhost/Z:/tmp/r"), ok("Z:/tmp/r"));
+        assert_eq!(w("file://C:/fmu/resources"), ok("C:/fmu/resources"));
+        assert_eq!(w("file:///C:/"), ok("C:/"));
+        assert_eq!(w("file:///C:"), ok("C:/"));
+        assert_eq!(
+            w("file://server/share/fmu/resources"),
+            ok("//server/share/fmu/resources")
+        );
+        assert_eq!(w(r"C:\fmu\resources\"), ok(r"C:\fmu\resources"));
+        assert_eq!(w(r"\\server\share\r"), ok(r"\\server\share\r"));
+        assert_eq!(w("file:///a/b"), ok("/a/b"));
+        assert!(w("fmu/resources").is_err());
+        assert!(w("C:fmu").is_err());
+        // the same texts on Linux
+        assert!(directory_text("file://server/share/r", false).is_err());
+        assert_eq!(directory_text("file:///C:/r", false), ok("/C:/r"));
+        assert!(directory_text(r"C:\r", false).is_err());
     }
 }

@@ -2,6 +2,7 @@
 //! running the built `fmu-harness` binary.
 #![allow(dead_code)]
 
+use fmu_harness::platform::{library_header, Platform};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -25,10 +26,22 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// A stand-in for the engine library: packaging only copies its bytes.
+/// A stand-in for the Linux engine library: an ELF x86-64 shared object's header, then
+/// `content` (packaging reads the header for the platform and copies the bytes).
 pub fn fake_engine(dir: &Path, content: &[u8]) -> PathBuf {
-    let p = dir.join("libfmu_beam.so");
-    std::fs::write(&p, content).expect("write fake engine");
+    fake_library(dir, Platform::Linux64, content)
+}
+
+/// A stand-in engine library of `platform` (`libfmu_beam.so` or `fmu_beam.dll` in `dir`).
+pub fn fake_library(dir: &Path, platform: Platform, content: &[u8]) -> PathBuf {
+    let name = match platform {
+        Platform::Linux64 => "libfmu_beam.so",
+        Platform::Win64 => "fmu_beam.dll",
+    };
+    let p = dir.join(name);
+    let mut bytes = library_header(platform, 0);
+    bytes.extend_from_slice(content);
+    std::fs::write(&p, bytes).expect("write fake engine");
     p
 }
 
@@ -49,6 +62,31 @@ pub fn package(scene: &Path, out: &Path, engine: &Path) -> Output {
         "--binary".as_ref(),
         engine.as_os_str(),
     ])
+}
+
+/// `fmu-harness package <scene> -o <out> --binary <b>...` with each `b` as given
+/// (`[PLATFORM=]PATH`).
+pub fn package_binaries(scene: &Path, out: &Path, binaries: &[String]) -> Output {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "package".as_ref(),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ];
+    for b in binaries {
+        args.extend(["--binary".as_ref(), std::ffi::OsStr::new(b)]);
+    }
+    harness(&args)
+}
+
+/// The bytes of one file inside a zip archive.
+pub fn read_entry_bytes(fmu: &Path, name: &str) -> Vec<u8> {
+    let f = std::fs::File::open(fmu).expect("open fmu");
+    let mut z = zip::ZipArchive::new(f).expect("fmu is a zip");
+    let mut e = z.by_name(name).expect("entry exists");
+    let mut b = Vec::new();
+    std::io::Read::read_to_end(&mut e, &mut b).expect("readable entry");
+    b
 }
 
 /// The text of one file inside a zip archive.
