@@ -558,12 +558,11 @@ impl Feedthrough {
         for u in sys.inputs_mut().iter_mut() {
             u.t0 = te;
         }
-        // a derivative input (rate, acceleration of a motion input) reads as slot 0 here: it
-        // matches no law `Input(slot)` of its own, and only `accelerations_by` uses it
+        // the input slot a known sets by value (a rate or acceleration input sets none: only the
+        // acceleration solve below reads those)
         let slot = |vr: u32| match table.get(vr).map(|v| v.binding) {
-            Some(Binding::Input(s)) => s,
-            Some(Binding::InputDerivative { .. }) => usize::MAX,
-            _ => unreachable!("checked: knowns are inputs"),
+            Some(Binding::Input(s)) => Some(s),
+            _ => None,
         };
         let needs_accel = unknowns.iter().any(|&vr| {
             matches!(
@@ -635,9 +634,12 @@ impl Feedthrough {
                         .iter()
                         .zip(dv)
                         .map(|(&vr, &d)| match drive {
-                            Some((DriveKind::Effort, law)) if law.law == Law::Input(slot(vr)) => {
-                                law.eval(st.t, &unit(slot(vr))).0 * d
-                            }
+                            Some((DriveKind::Effort, law)) => match slot(vr) {
+                                Some(s) if law.law == Law::Input(s) => {
+                                    law.eval(st.t, &unit(s)).0 * d
+                                }
+                                _ => 0.0,
+                            },
                             _ => 0.0,
                         })
                         .sum()
@@ -671,7 +673,7 @@ fn residual_derivative(
     st: &GaState,
     knowns: &[u32],
     dv: &[f64],
-    slot: impl Fn(u32) -> usize,
+    slot: impl Fn(u32) -> Option<usize>,
     unit: &impl Fn(usize) -> Vec<InputValue>,
 ) -> f64 {
     let m = sys.m();
@@ -683,8 +685,8 @@ fn residual_derivative(
     let mut dg: DVector<f64> = DVector::zeros(m);
     for (row, law) in motion_rows(sys) {
         for (&vr, &d) in knowns.iter().zip(dv) {
-            if law.law == Law::Input(slot(vr)) {
-                dg[row] -= law.eval(st.t, &unit(slot(vr))).0 * d;
+            if let Some(s) = slot(vr).filter(|&s| law.law == Law::Input(s)) {
+                dg[row] -= law.eval(st.t, &unit(s)).0 * d;
             }
         }
     }
