@@ -78,22 +78,37 @@ start = {{ {start} }}
 
 /// The monolithic unit's slider position at every communication point, same fixed step.
 fn monolithic(dir: &Path, h: f64, stop: f64, rho: f64) -> Vec<f64> {
-    let mut s = Slave::load(&dir.join("slider_crank.fmu")).unwrap();
-    s.instantiate("mono", false).unwrap();
+    let fmu = dir.join("slider_crank.fmu");
+    let rows = run_alone(&fmu, h, stop, &[("crank.rho", rho)], &["slider.position"]);
+    rows.into_iter().map(|r| r[0]).collect()
+}
+
+/// One unit alone at a fixed step `h` (internal step and communication step), Real parameters
+/// set: `outputs` at every communication point.
+fn run_alone(
+    fmu: &Path,
+    h: f64,
+    stop: f64,
+    reals: &[(&str, f64)],
+    outputs: &[&str],
+) -> Vec<Vec<f64>> {
+    let mut s = Slave::load(fmu).unwrap();
+    s.instantiate("alone", false).unwrap();
     let md = s.model_description.clone();
     let vr = |n: &str| md.variable(n).unwrap().value_reference;
-    s.set_real(&[vr("crank.rho"), vr("solver.max_step")], &[rho, h])
-        .unwrap();
+    for &(name, value) in reals.iter().chain(&[("solver.max_step", h)]) {
+        s.set_real(&[vr(name)], &[value]).unwrap();
+    }
     s.set_boolean(&[vr("solver.adaptive")], &[false]).unwrap();
     s.setup_experiment(None, 0.0, Some(stop)).unwrap();
     s.enter_initialization_mode().unwrap();
     s.exit_initialization_mode().unwrap();
-    let slider = vr("slider.position");
+    let vrs: Vec<u32> = outputs.iter().map(|o| vr(o)).collect();
     let n = (stop / h).round() as usize;
-    let mut out = vec![s.get_real(&[slider]).unwrap()[0]];
+    let mut out = vec![s.get_real(&vrs).unwrap()];
     for k in 0..n {
         s.do_step(k as f64 * h, h, false).unwrap();
-        out.push(s.get_real(&[slider]).unwrap()[0]);
+        out.push(s.get_real(&vrs).unwrap());
     }
     out
 }
@@ -234,22 +249,13 @@ start = {{ {start} }}
     let (results, summary) = cosim::run(&sys, &path).unwrap();
     let coupled: Vec<Vec<f64>> = results.rows.iter().map(|r| r[1..].to_vec()).collect();
 
-    let mut s = Slave::load(&dir.join("pendulum_3d_double.fmu")).unwrap();
-    s.instantiate("mono", false).unwrap();
-    let md = s.model_description.clone();
-    let vr = |n: &str| md.variable(n).unwrap().value_reference;
-    s.set_real(&[vr("solver.max_step")], &[h]).unwrap();
-    s.set_boolean(&[vr("solver.adaptive")], &[false]).unwrap();
-    s.setup_experiment(None, 0.0, Some(stop)).unwrap();
-    s.enter_initialization_mode().unwrap();
-    s.exit_initialization_mode().unwrap();
-    let tip = [vr("lower.tip.x"), vr("lower.tip.y"), vr("lower.tip.z")];
-    let n = (stop / h).round() as usize;
-    let mut mono = vec![s.get_real(&tip).unwrap()];
-    for k in 0..n {
-        s.do_step(k as f64 * h, h, false).unwrap();
-        mono.push(s.get_real(&tip).unwrap());
-    }
+    let mono = run_alone(
+        &dir.join("pendulum_3d_double.fmu"),
+        h,
+        stop,
+        &[],
+        &["lower.tip.x", "lower.tip.y", "lower.tip.z"],
+    );
 
     // the lower beam leaves the upper one's x-z plane (y falls from 0.2 m through zero)
     let least_y = mono.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
