@@ -906,7 +906,7 @@ fn check_beam<'a>(
 fn planar_3d(sys: &crate::multibody::System, q: &nalgebra::DVector<f64>, kind: OutputKind) -> f64 {
     use OutputKind as K;
     match kind {
-        K::TipDeflectionY(g) => sys.beam_transverse(g, q, sys.beam_tip(g, q).0),
+        K::TipDeflectionY(g) => sys.beam_tip_deflection(g, q),
         _ => 0.0, // tip z, deflection along z, twist and body z
     }
 }
@@ -999,7 +999,7 @@ fn output(m: &Model, kind: OutputKind) -> f64 {
     let st = &m.state;
     let (q, v) = (&st.q, &st.v);
     match kind {
-        K::TipDeflection(g) => sys.beam_transverse(g, q, sys.beam_tip(g, q).0),
+        K::TipDeflection(g) => sys.beam_tip_deflection(g, q),
         K::TipX(g) => sys.beam_tip(g, q).0[0],
         K::TipY(g) => sys.beam_tip(g, q).0[1],
         K::TipPhi(g) => sys.beam_tip(g, q).1,

@@ -557,7 +557,7 @@ impl VariableTable {
                     "tip.deflection" => (
                         K::TipDeflection(i),
                         "m",
-                        "Transverse displacement of flange b in the beam frame",
+                        "Transverse displacement of flange b from the tangent at flange a",
                     ),
                     "tip.x" => (K::TipX(i), "m", "World x of flange b"),
                     "tip.y" => (K::TipY(i), "m", "World y of flange b"),

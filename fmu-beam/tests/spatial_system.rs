@@ -144,13 +144,12 @@ fn c2_props(elements: usize) -> SpatialBeamProps {
 /// C2 in 3D: hinge angle and tip deflection every 10 ms over 1 s at fixed step h.
 fn c2_3d(h: f64) -> Vec<(f64, f64)> {
     let mut sys = System3::new(Some(Vector3::new(0.0, -9.81, 0.0)));
-    let g = sys.add_beam(
-        "beam",
-        &c2_props(10),
-        1,
-        Vector3::zeros(),
-        Matrix3::identity(),
-    );
+    // in the shipped scene's frame, through both ends
+    let props = SpatialBeamProps {
+        frame: FrameKind::Pinned,
+        ..c2_props(10)
+    };
+    let g = sys.add_beam("beam", &props, 1, Vector3::zeros(), Matrix3::identity());
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
     let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, fa, None);
@@ -213,12 +212,13 @@ fn c2_in_3d_agrees_with_the_planar_engine() {
         );
         rows.push((da, dd));
     }
-    // The bar of 1e-6 is reached at h = 5e-4 for the angle, not at h = 1e-3:
-    // generalized-α is not invariant under the change of rotation coordinates (angle vs
-    // quaternion), so the two runs differ by discretization error, which shrinks with h
-    // (measured: angle 5.7e-6 → 9.9e-7, deflection 1.5e-5 → 4.2e-6 for h/2).
+    // The bar of 1e-6 is not reached at h = 1e-3: generalized-α is not invariant
+    // under the change of rotation coordinates (angle vs quaternion), so the two runs differ
+    // by discretization error, which shrinks with h at the scheme's order 2 (measured, pinned
+    // frames: angle 5.69e-6 → 1.42e-6, deflection 1.03e-5 → 2.54e-6 for h/2; tangent frames:
+    // 5.7e-6 → 9.9e-7 and 1.5e-5 → 4.2e-6).
     assert!(
-        rows[0].0 < 1e-5 && rows[1].0 < rows[0].0 / 4.0,
+        rows[0].0 < 1e-5 && rows[1].0 < rows[0].0 / 3.0,
         "angle converges together"
     );
     assert!(

@@ -875,6 +875,26 @@ impl System {
         }
     }
 
+    /// World position and angle of the root (flange a) of beam group `g`: the tangent there.
+    pub fn beam_root(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let first = self.beams[g].bodies.start;
+        let z = self.body_coords(first, q);
+        match &self.bodies[first] {
+            Body::Beam(b) => b.point(&b.flange_a, z),
+            Body::Rigid(r) => r_point(r, "a", z),
+        }
+    }
+
+    /// Transverse displacement of the tip (flange b) of beam group `g` from the tangent at its
+    /// root (flange a), whatever the frame: for a tangent frame that tangent is the frame's
+    /// axis; a pinned frame's axis is the chord, from which the tip does not deflect.
+    pub fn beam_tip_deflection(&self, g: usize, q: &DVector<f64>) -> f64 {
+        let (root, phi) = self.beam_root(g, q);
+        let d = self.beam_tip(g, q).0 - root;
+        let (s, c) = phi.sin_cos();
+        c * d.y - s * d.x
+    }
+
     /// Transverse displacement of a world point from the beam's root axis (or, for a pinned
     /// frame, from the chord flange a → flange b).
     pub fn beam_transverse(&self, g: usize, q: &DVector<f64>, p: Vector2<f64>) -> f64 {

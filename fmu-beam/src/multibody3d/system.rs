@@ -544,12 +544,21 @@ impl System3 {
             .pose(Some(self.body_coords(last, q)))
     }
 
-    /// The tip of beam `g` in its root frame (frame of the first substructure): its y and z
-    /// components are the tip deflections.
+    /// The tip of beam `g` in the frame of its root flange (flange a: the tangent there,
+    /// whatever the beam's frame; for a tangent frame, the frame of the first substructure):
+    /// its y and z components are the tip deflections.
     pub fn beam_tip_local(&self, g: usize, q: &DVector<f64>) -> Vector3<f64> {
         let first = self.beams[g].bodies.start;
         let z = self.body_coords(first, q);
-        let (r, _, a) = super::body::frame_of(&z);
+        let (r, a) = match &self.bodies[first] {
+            Body3::Beam(b) => {
+                Frame3::on_body(first, b.flange_a.clone(), Matrix3::identity()).pose(Some(z))
+            }
+            _ => {
+                let (r, _, a) = super::body::frame_of(&z);
+                (r, a)
+            }
+        };
         a.transpose() * (self.beam_tip(g, q).0 - r)
     }
 
