@@ -185,6 +185,10 @@ pub enum Command {
         /// Only these cases (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
         #[arg(long, value_delimiter = ',')]
         cases: Vec<String>,
+        /// Our points from an earlier run (its ours_points.csv) instead of a new sweep: the
+        /// report again, in seconds.
+        #[arg(long)]
+        ours_points: Option<PathBuf>,
     },
     /// Dense against sparse LU of the iteration matrix: C2's pendulum and C4's spin-up with
     /// k = 5…80 substructures and C1's beam with e elements, at fixed steps; CPU time per step,
@@ -281,6 +285,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             repeats,
             budget,
             cases,
+            ours_points,
         } => {
             use work_precision::peer;
             let chosen: Vec<_> = peer::cases()
@@ -289,14 +294,20 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 .collect();
             let started = std::time::Instant::now();
             let mut progress = |line: &str| eprintln!("{line}");
-            let ours = peer::study(
-                &scenes,
-                &references,
-                &chosen,
-                repeats,
-                budget,
-                &mut progress,
-            )?;
+            let ours = match &ours_points {
+                Some(path) => peer::read_peer(path)?
+                    .into_iter()
+                    .filter(|p| chosen.iter().any(|c| c.name == p.case))
+                    .collect(),
+                None => peer::study(
+                    &scenes,
+                    &references,
+                    &chosen,
+                    repeats,
+                    budget,
+                    &mut progress,
+                )?,
+            };
             let theirs = if peer_points.is_file() {
                 peer::read_peer(&peer_points)?
             } else {
@@ -308,12 +319,19 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 .map_err(stdout_err)?;
                 Vec::new()
             };
-            let header = format!(
-                "{} timed runs per point; our sweep took {:.0} s; the peer's points from {}.",
-                repeats,
-                started.elapsed().as_secs_f64(),
-                peer_points.display()
-            );
+            let header = match &ours_points {
+                Some(path) => format!(
+                    "Our points from {}; the peer's points from {}.",
+                    path.display(),
+                    peer_points.display()
+                ),
+                None => format!(
+                    "{} timed runs per point; our sweep took {:.0} s; the peer's points from {}.",
+                    repeats,
+                    started.elapsed().as_secs_f64(),
+                    peer_points.display()
+                ),
+            };
             let text = peer::report(&chosen, &ours, &theirs, &header);
             for path in peer::write(&output, &ours, &text)? {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;

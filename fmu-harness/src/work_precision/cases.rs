@@ -19,6 +19,8 @@ pub enum Edit {
     Modes(&'static str, usize),
     /// Add the geometric stiffness of the axial force.
     Stiffening(&'static str),
+    /// The deformation's frame through both ends (`frame = "pinned"`).
+    Pinned(&'static str),
 }
 
 /// A formulation of a case: the case's scene with some edits.
@@ -53,7 +55,8 @@ impl Formulation {
                 | Edit::Substructures(b, ..)
                 | Edit::Rigid(b)
                 | Edit::Modes(b, _)
-                | Edit::Stiffening(b) => b,
+                | Edit::Stiffening(b)
+                | Edit::Pinned(b) => b,
             };
             let b = s
                 .beams
@@ -74,6 +77,7 @@ impl Formulation {
                 Edit::Rigid(_) => b.rigid = true,
                 Edit::Modes(_, k) => b.modes = Some(k),
                 Edit::Stiffening(_) => b.geometric_stiffening = true,
+                Edit::Pinned(_) => b.frame = fmu_beam::scene::FrameKind::Pinned,
             }
         }
         s

@@ -77,6 +77,7 @@ pub fn cases() -> Vec<PeerCase> {
         H(5e-3),
         H(2e-3),
         H(1e-3),
+        H(5e-4),
         Tol(1e-4),
         Tol(1e-5),
         Tol(1e-6),
@@ -98,9 +99,19 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("5 x 2 substructures", &[Substructures("beam", 5, 2)]),
                 formulation("10 x 2 substructures", &[Substructures("beam", 10, 2)]),
                 formulation("20 x 2 substructures", &[Substructures("beam", 20, 2)]),
-                formulation("single frame, 10 elements", &[Elements("beam", 10)]),
-                formulation("single frame, 6 elements", &[Elements("beam", 6)]),
-                formulation("single frame, 4 elements", &[Elements("beam", 4)]),
+                // pinned, as the shipped single-frame scene (flexible_pendulum.toml)
+                formulation(
+                    "single frame, 10 elements",
+                    &[Elements("beam", 10), Pinned("beam")],
+                ),
+                formulation(
+                    "single frame, 6 elements",
+                    &[Elements("beam", 6), Pinned("beam")],
+                ),
+                formulation(
+                    "single frame, 4 elements",
+                    &[Elements("beam", 4), Pinned("beam")],
+                ),
                 formulation("3 x 2 substructures", &[Substructures("beam", 3, 2)]),
             ],
             settings: vec![
@@ -110,6 +121,10 @@ pub fn cases() -> Vec<PeerCase> {
                 H(5e-4),
                 H(2e-4),
                 H(1e-4),
+                // the tip deflection's error is the phase of the modes at 260-430 Hz that the
+                // release excites: it needs steps this short (issue 12)
+                H(5e-5),
+                H(2e-5),
                 Tol(1e-4),
                 Tol(1e-5),
                 Tol(1e-6),
@@ -189,6 +204,10 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("3 x 1 substructures", &[Substructures("beam", 3, 1)]),
                 formulation("5 x 1 substructures", &[Substructures("beam", 5, 1)]),
                 formulation("10 x 1 substructures", &[Substructures("beam", 10, 1)]),
+                // 1e-5 needs more: 10 x 1 stops near 1.1e-4 and 20 x 1 near 1.8e-5 whatever
+                // the step; 40 x 1 reaches 8.4e-6 at 5e-4 s
+                formulation("20 x 1 substructures", &[Substructures("beam", 20, 1)]),
+                formulation("40 x 1 substructures", &[Substructures("beam", 40, 1)]),
             ],
             settings: c4_settings,
         },
@@ -441,7 +460,51 @@ fn split_csv(line: &str) -> Vec<String> {
     fields
 }
 
-/// The cheapest point (median CPU) meeting `target`, among those of `tool` for (case, output).
+/// A setting as a family and its size, smaller being tighter: ours `fixed step 1.0e-3 s` and
+/// `tolerance 1e-6` (families `fixed step`, `tolerance`), the peer's `ne=16;h=5e-05;rho_inf=0.9`
+/// (family `ne=16;rho_inf=0.9`, size the step h).
+fn family(setting: &str) -> Option<(String, f64)> {
+    for mode in ["fixed step", "tolerance"] {
+        if let Some(rest) = setting.strip_prefix(mode) {
+            let value = rest.trim().trim_end_matches(" s").parse().ok()?;
+            return Some((mode.to_string(), value));
+        }
+    }
+    let fields: Vec<&str> = setting.split(';').collect();
+    let h = fields
+        .iter()
+        .find_map(|f| f.strip_prefix("h="))?
+        .parse()
+        .ok()?;
+    let rest: Vec<&str> = fields
+        .into_iter()
+        .filter(|f| !f.starts_with("h="))
+        .collect();
+    Some((rest.join(";"), h))
+}
+
+/// Whether `p` meets `target` for good: it does, and so does every tighter setting of its
+/// family run with the same formulation. A run whose error crosses below the target on its way
+/// to a floor above it (the time error cancelling the formulation's) does not count: the next
+/// tighter setting would not meet it, and neither would a user's.
+fn meets(points: &[PeerPoint], p: &PeerPoint, target: f64) -> bool {
+    if p.error > target {
+        return false;
+    }
+    let Some((fam, size)) = family(&p.setting) else {
+        return true;
+    };
+    points.iter().all(|q| {
+        q.tool != p.tool
+            || q.case != p.case
+            || q.output != p.output
+            || q.formulation != p.formulation
+            || family(&q.setting).is_none_or(|(f, s)| f != fam || s >= size || q.error <= target)
+    })
+}
+
+/// The cheapest point (median CPU) meeting `target` for good ([`meets`]), among those of
+/// `tool` for (case, output).
 fn cheapest<'a>(
     points: &'a [PeerPoint],
     tool: &str,
@@ -451,7 +514,8 @@ fn cheapest<'a>(
 ) -> Option<&'a PeerPoint> {
     points
         .iter()
-        .filter(|p| p.tool == tool && p.case == case && p.output == output && p.error <= target)
+        .filter(|p| p.tool == tool && p.case == case && p.output == output)
+        .filter(|p| meets(points, p, target))
         .min_by(|a, b| a.seconds[0].total_cmp(&b.seconds[0]))
 }
 
@@ -490,8 +554,11 @@ pub fn report(
         format!("# Against the peer: fmu-beam and Exudyn at equal accuracy\n\n{header}\n\n");
     s += "CPU time of the cheapest run of each tool whose largest error against the exact \
           reference (`bench/reference/`) is at most the target, as the ratio ours / Exudyn's \
-          (median of the timed runs; below 1: we are faster). `ours n.r.`: our sweep does not \
-          reach the target; `peer n.r.`: Exudyn's does not.\n\n";
+          (median of the timed runs; below 1: we are faster). A run counts only if every \
+          tighter setting of the same formulation (smaller fixed step, or tolerance) that ran \
+          meets the target too: an error that crosses below the target on its way to a floor \
+          above it is luck, not accuracy. `ours n.r.`: our sweep does not reach the target; \
+          `peer n.r.`: Exudyn's does not.\n\n";
     s += "| case, output |";
     for t in TARGETS {
         let _ = write!(s, " {t:.0e} |");
@@ -550,4 +617,64 @@ pub fn write(dir: &Path, ours: &[PeerPoint], report: &str) -> Result<Vec<PathBuf
     let b = dir.join("PEER.md");
     std::fs::write(&b, report).map_err(|e| HarnessError::io(&b, "writing", e))?;
     Ok(vec![a, b])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(tool: &str, formulation: &str, setting: &str, error: f64, cpu: f64) -> PeerPoint {
+        PeerPoint {
+            case: "c2".into(),
+            output: "chord_angle".into(),
+            tool: tool.into(),
+            formulation: formulation.into(),
+            setting: setting.into(),
+            error,
+            seconds: [cpu; 3],
+            steps: 0,
+        }
+    }
+
+    #[test]
+    fn settings_are_families_with_a_size() {
+        assert_eq!(
+            family("fixed step 1.0e-3 s"),
+            Some(("fixed step".into(), 1e-3))
+        );
+        assert_eq!(family("tolerance 1e-6"), Some(("tolerance".into(), 1e-6)));
+        assert_eq!(
+            family("ne=16;h=5e-05;rho_inf=0.9"),
+            Some(("ne=16;rho_inf=0.9".into(), 5e-5))
+        );
+        assert_eq!(family("something else"), None);
+    }
+
+    /// The single frame of 6 elements on C2 (measured): its error crosses 1e-5 at tolerance
+    /// 1e-6 (4.8e-6) on its way to its floor of 2.3e-5; the cheapest run that stays below
+    /// 1e-5 is another formulation's.
+    #[test]
+    fn an_error_that_crosses_the_target_on_its_way_to_a_floor_above_does_not_count() {
+        let points = [
+            point("fmu-beam", "six", "tolerance 1e-5", 1.2e-4, 0.013),
+            point("fmu-beam", "six", "tolerance 1e-6", 4.8e-6, 0.036),
+            point("fmu-beam", "six", "tolerance 1e-7", 2.2e-5, 0.108),
+            point("fmu-beam", "six", "fixed step 2.0e-4 s", 1.9e-5, 0.039),
+            point("fmu-beam", "ten", "fixed step 2.0e-4 s", 7.4e-6, 0.064),
+            point("fmu-beam", "ten", "fixed step 1.0e-4 s", 2.9e-6, 0.120),
+        ];
+        assert!(!meets(&points, &points[1], 1e-5));
+        assert!(meets(&points, &points[1], 1e-4));
+        let best = cheapest(&points, "fmu-beam", "c2", "chord_angle", 1e-5).unwrap();
+        assert_eq!((best.formulation.as_str(), best.seconds[0]), ("ten", 0.064));
+        // the tightest run of a family has nothing tighter to contradict it
+        let peer = [point(
+            "exudyn",
+            "ancf",
+            "ne=16;h=5e-05;rho_inf=0.9",
+            6e-4,
+            1.5,
+        )];
+        assert!(meets(&peer, &peer[0], 1e-3));
+    }
 }
