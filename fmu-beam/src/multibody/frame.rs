@@ -60,7 +60,9 @@ impl<'a> FrameState<'a> {
         let (ar, ath) = rot(z[THETA]);
         let s = body.local_point(map, z);
         let aths = ath * s;
-        let (p, phi) = body.point(map, z);
+        // Body::point, with the rotation and the local point already at hand
+        let p = Vector2::new(z[0], z[1]) + ar * s;
+        let phi = z[THETA] + map.sphi.dot(&z.rows(FLEX, nf));
         let mut fs = FrameState {
             body: Some(index),
             p,
@@ -93,6 +95,10 @@ impl<'a> FrameState<'a> {
         visit(THETA, w.dot(&self.aths) + c);
         let local = self.ar.tr_mul(&w);
         for k in 0..map.sp.ncols() {
+            // a coordinate that does not move the frame (most of a flange's body)
+            if map.sp[(0, k)] == 0.0 && map.sp[(1, k)] == 0.0 && map.sphi[k] == 0.0 {
+                continue;
+            }
             visit(
                 FLEX + k,
                 local[0] * map.sp[(0, k)] + local[1] * map.sp[(1, k)] + c * map.sphi[k],
