@@ -117,7 +117,9 @@ pub struct SolverSpec {
     /// Local error control on (true) or a fixed internal step of `max_step` (false).
     #[serde(default = "default_adaptive")]
     pub adaptive: bool,
-    /// Relative tolerance of the error control and of the Newton iteration.
+    /// Relative tolerance of the error control and of the Newton iteration, on each coordinate
+    /// against tol × (|q| + the system's length; 1 rad for angles). At a fixed step it bounds only
+    /// Newton's error: set it below the accuracy asked of the outputs.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
