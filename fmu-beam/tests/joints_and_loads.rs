@@ -38,26 +38,16 @@ type = "weld"
 frames = ["world", "beam.a"]
 "#;
 
-/// Tip deflection and rotation of the damped cantilever settled under `load`.
-fn settled_tip(load: &str) -> (f64, f64) {
+/// Tip deflection and rotation of a damped cantilever scene, settled.
+fn settled(scene: Scene) -> (f64, f64) {
     let outs = ["beam.tip.deflection", "beam.tip.phi"];
-    let r = run(cantilever(load, CLAMP), &[], &outs, 0.05, 3.0);
+    let r = run(scene, &[], &outs, 0.05, 3.0);
     (r.last(1), r.last(2))
 }
 
-/// The same in a pinned frame. Mass-proportional damping acts on the motion relative to the
-/// frame, and a pinned frame turns with the cantilever's first mode, so the damping here is
-/// stiffness-proportional (on the strain rate, the same in every frame): ζ ≈ 0.5 on that mode.
-fn settled_tip_pinned(load: &str) -> (f64, f64) {
-    let outs = ["beam.tip.deflection", "beam.tip.phi"];
-    let r = run(
-        cantilever_in("pinned", "beta = 0.01", load, CLAMP),
-        &[],
-        &outs,
-        0.05,
-        3.0,
-    );
-    (r.last(1), r.last(2))
+/// Tip deflection and rotation of the damped cantilever settled under `load`.
+fn settled_tip(load: &str) -> (f64, f64) {
+    settled(cantilever(load, CLAMP))
 }
 
 /// Small-deflection FE of the linear element: exact at the nodes, up to the axial shortening
@@ -67,37 +57,41 @@ fn assert_close(what: &str, got: f64, want: f64) {
     assert!((got - want).abs() < 1e-4 * want.abs(), "{what}");
 }
 
-/// A transverse tip force F: deflection F L³ / (3 E J), rotation F L² / (2 E J).
-#[test]
-fn tip_force_settles_at_the_static_deflection() {
+/// A transverse tip force F on the cantilever that `scene` builds around a load: deflection
+/// F L³ / (3 E J), rotation F L² / (2 E J).
+fn assert_tip_force_response(frame: &str, scene: impl Fn(&str) -> Scene) {
     let f = 50.0;
-    let (d, phi) = settled_tip(&format!(
+    let (d, phi) = settled(scene(&format!(
         "[[load]]\nname = \"push\"\nframe = \"beam.b\"\nforce = [0.0, {f}]\n"
-    ));
-    let ej = 210e9 * 0.01 * 0.02f64.powi(3) / 12.0;
-    assert_close("tip deflection under F (m)", d, f / (3.0 * ej));
-    assert_close("tip rotation under F (rad)", phi, f / (2.0 * ej));
-}
-
-/// A pinned frame's axis is the chord, but the tip deflection is measured from the tangent at
-/// flange a in every frame: the same F L³ / (3 E J) (it used to read 0, the tip on the chord).
-#[test]
-fn a_pinned_frame_measures_the_tip_deflection_from_the_root_tangent() {
-    let f = 50.0;
-    let (d, phi) = settled_tip_pinned(&format!(
-        "[[load]]\nname = \"push\"\nframe = \"beam.b\"\nforce = [0.0, {f}]\n"
-    ));
+    )));
     let ej = 210e9 * 0.01 * 0.02f64.powi(3) / 12.0;
     assert_close(
-        "tip deflection under F, pinned frame (m)",
+        &format!("tip deflection under F, {frame} frame (m)"),
         d,
         f / (3.0 * ej),
     );
     assert_close(
-        "tip rotation under F, pinned frame (rad)",
+        &format!("tip rotation under F, {frame} frame (rad)"),
         phi,
         f / (2.0 * ej),
     );
+}
+
+#[test]
+fn tip_force_settles_at_the_static_deflection() {
+    assert_tip_force_response("tangent", |load| cantilever(load, CLAMP));
+}
+
+/// A pinned frame's axis is the chord, but the tip deflection is measured from the tangent at
+/// flange a in every frame (it used to read 0, the tip on the chord). Mass-proportional damping
+/// acts on the motion relative to the frame, and a pinned frame turns with the cantilever's
+/// first mode, so the damping here is stiffness-proportional (on the strain rate, the same in
+/// every frame): ζ ≈ 0.5 on that mode.
+#[test]
+fn a_pinned_frame_measures_the_tip_deflection_from_the_root_tangent() {
+    assert_tip_force_response("pinned", |load| {
+        cantilever_in("pinned", "beta = 0.01", load, CLAMP)
+    });
 }
 
 /// A tip torque M: deflection M L² / (2 E J), rotation M L / (E J).
