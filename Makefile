@@ -146,7 +146,7 @@ bench: .venv release
 
 # Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
 # and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
-# steps or tolerances (fmu-harness peer, about 6 min), both scored against the exact references
+# steps or tolerances (fmu-harness peer, about 8 min), both scored against the exact references
 # of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy.
 VENV_BENCH  := .venv-bench
 BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp

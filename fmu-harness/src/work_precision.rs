@@ -702,3 +702,44 @@ pub fn header(options: &Options, wall_seconds: f64) -> String {
         options.repeats.max(EFFECTS_REPEATS)
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shipped(name: &str) -> Scene {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+        Scene::load(&dir.join(name)).unwrap()
+    }
+
+    /// Every formulation of `make bench` and `make bench-peer` is a scene the rules accept,
+    /// built on the shipped scene as it is now (a shipped scene that gained geometric stiffness
+    /// once made the rigid C2 formulation a refused scene, and `make bench` stopped there).
+    #[test]
+    fn every_bench_formulation_is_an_accepted_scene() {
+        for case in cases::cases() {
+            let base = shipped(case.scene);
+            let mut all: Vec<&Formulation> = case.formulations.iter().collect();
+            if let Reference::Run { formulation, .. } = &case.reference {
+                all.push(formulation);
+            }
+            for f in all {
+                for &setting in &case.settings {
+                    if let Err(e) = build(&base, &case, f, setting, EffectsSpec::default()) {
+                        panic!("{} {}: {e}", case.name, f.name);
+                    }
+                }
+            }
+        }
+        for case in peer::cases() {
+            let base = shipped(case.scene);
+            for f in &case.formulations {
+                for &setting in &case.settings {
+                    if let Err(e) = peer::configure(&base, f, setting, Some(1e-8)) {
+                        panic!("{} {}: {e}", case.name, f.name);
+                    }
+                }
+            }
+        }
+    }
+}

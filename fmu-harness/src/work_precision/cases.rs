@@ -13,12 +13,14 @@ pub enum Edit {
     Elements(&'static str, usize),
     /// `k` substructures of `n` elements each.
     Substructures(&'static str, usize, usize),
-    /// A rigid bar.
+    /// A rigid bar (without the geometric stiffness a flexible beam of the scene may carry).
     Rigid(&'static str),
     /// Keep the lowest `k` modes of each frame.
     Modes(&'static str, usize),
     /// Add the geometric stiffness of the axial force.
     Stiffening(&'static str),
+    /// Without the geometric stiffness (a linear beam, whatever the shipped scene carries).
+    Linear(&'static str),
     /// The deformation's frame through both ends (`frame = "pinned"`).
     Pinned(&'static str),
 }
@@ -56,6 +58,7 @@ impl Formulation {
                 | Edit::Rigid(b)
                 | Edit::Modes(b, _)
                 | Edit::Stiffening(b)
+                | Edit::Linear(b)
                 | Edit::Pinned(b) => b,
             };
             let b = s
@@ -74,9 +77,14 @@ impl Formulation {
                     b.substructures = Some(k);
                     b.elements_per_substructure = Some(n);
                 }
-                Edit::Rigid(_) => b.rigid = true,
+                Edit::Rigid(_) => {
+                    // a rigid bar carries no geometric stiffness (the scene rules refuse both)
+                    b.rigid = true;
+                    b.geometric_stiffening = false;
+                }
                 Edit::Modes(_, k) => b.modes = Some(k),
                 Edit::Stiffening(_) => b.geometric_stiffening = true,
+                Edit::Linear(_) => b.geometric_stiffening = false,
                 Edit::Pinned(_) => b.frame = fmu_beam::scene::FrameKind::Pinned,
             }
         }
@@ -310,7 +318,10 @@ pub fn cases() -> Vec<Case> {
                     "single frame, 20 elements + stiffening",
                     &[Elements("beam", 20), Stiffening("beam")],
                 ),
-                Formulation::new("single frame, 10 elements, linear", &[Elements("beam", 10)]),
+                Formulation::new(
+                    "single frame, 10 elements, linear",
+                    &[Elements("beam", 10), Linear("beam")],
+                ),
             ],
             settings: vec![H(1e-2), H(3e-3), H(1e-3), Tol(1e-4), Tol(1e-5), Tol(1e-6)],
             reference: Reference::Run {

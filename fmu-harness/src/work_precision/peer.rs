@@ -275,7 +275,7 @@ fn setting_name(setting: Setting, newton: Option<f64>) -> String {
     }
 }
 
-fn configure(
+pub(super) fn configure(
     base: &Scene,
     f: &Formulation,
     setting: Setting,
