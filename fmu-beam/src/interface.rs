@@ -606,16 +606,7 @@ impl Feedthrough {
             dqdd = x.rows(0, n).into_owned();
             dlambda = x.rows(n, m).into_owned();
         }
-        let unit = |s: usize| {
-            let mut u = vec![InputValue::default(); sys.inputs().len()];
-            u[s] = InputValue {
-                value: 1.0,
-                der1: 0.0,
-                der2: 0.0,
-                t0: st.t,
-            };
-            u
-        };
+        let unit = |s: usize| InputValue::unit(sys.inputs().len(), s, st.t);
         let mut out = Vec::with_capacity(unknowns.len());
         for &vr in unknowns {
             let kind = match table.get(vr).map(|v| v.binding) {

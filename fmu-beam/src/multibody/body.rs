@@ -3,7 +3,7 @@
 
 use super::rigid_body::RigidBody;
 use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, TermCounts, FLEX, THETA};
-use nalgebra::{DMatrixViewMut, DVectorView, Vector2};
+use nalgebra::{DMatrixViewMut, DVectorView, Matrix2, Vector2};
 
 #[derive(Debug, Clone)]
 pub enum Body {
@@ -129,7 +129,18 @@ impl Body {
     /// World position and angle of a material point.
     pub fn point(&self, map: &PointMap, z: DVectorView<f64>) -> (Vector2<f64>, f64) {
         let (ar, _) = rot(z[THETA]);
-        let s = self.local_point(map, z);
+        self.placed(map, z, &ar, self.local_point(map, z))
+    }
+
+    /// [`Body::point`] with the body's rotation `ar` and the point's body-frame position `s`
+    /// already at hand.
+    pub fn placed(
+        &self,
+        map: &PointMap,
+        z: DVectorView<f64>,
+        ar: &Matrix2<f64>,
+        s: Vector2<f64>,
+    ) -> (Vector2<f64>, f64) {
         let f = z.rows(FLEX, self.nflex());
         (
             Vector2::new(z[0], z[1]) + ar * s,

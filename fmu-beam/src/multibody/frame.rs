@@ -60,9 +60,7 @@ impl<'a> FrameState<'a> {
         let (ar, ath) = rot(z[THETA]);
         let s = body.local_point(map, z);
         let aths = ath * s;
-        // Body::point, with the rotation and the local point already at hand
-        let p = Vector2::new(z[0], z[1]) + ar * s;
-        let phi = z[THETA] + map.sphi.dot(&z.rows(FLEX, nf));
+        let (p, phi) = body.placed(map, z, &ar, s);
         let mut fs = FrameState {
             body: Some(index),
             p,

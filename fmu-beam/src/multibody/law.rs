@@ -13,6 +13,21 @@ pub struct InputValue {
     pub t0: f64,
 }
 
+impl InputValue {
+    /// `n` inputs of which only `slot` is 1 (constant, set at t): one unit of that input, for
+    /// the derivatives of what acts linearly in the inputs.
+    pub fn unit(n: usize, slot: usize, t: f64) -> Vec<InputValue> {
+        let mut u = vec![InputValue::default(); n];
+        u[slot] = InputValue {
+            value: 1.0,
+            der1: 0.0,
+            der2: 0.0,
+            t0: t,
+        };
+        u
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Law {
     Constant(f64),

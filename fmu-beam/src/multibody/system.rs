@@ -827,13 +827,7 @@ impl System {
             };
             push(&fs, w, c);
         }
-        let mut unit = vec![InputValue::default(); self.inputs.len()];
-        unit[slot] = InputValue {
-            value: 1.0,
-            der1: 0.0,
-            der2: 0.0,
-            t0: t,
-        };
+        let unit = InputValue::unit(self.inputs.len(), slot, t);
         for j in &self.joints {
             let reads = j.drive.as_ref().is_some_and(|d| {
                 d.kind == DriveKind::Effort && d.law.law == super::law::Law::Input(slot)
@@ -866,23 +860,21 @@ impl System {
 
     /// World position and angle of the tip (flange b) of beam group `g`, and of its root frame.
     pub fn beam_tip(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
-        let grp = &self.beams[g];
-        let last = grp.bodies.end - 1;
-        let z = self.body_coords(last, q);
-        match &self.bodies[last] {
-            Body::Beam(b) => b.point(&b.flange_b, z),
-            Body::Rigid(r) => r_point(r, "b", z),
+        self.flange(self.beams[g].bodies.end - 1, true, q)
+    }
+
+    /// World position and angle of flange b (`tip`) or a of `body`, a beam or a rigid bar.
+    fn flange(&self, body: usize, tip: bool, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let z = self.body_coords(body, q);
+        match &self.bodies[body] {
+            Body::Beam(b) => b.point(if tip { &b.flange_b } else { &b.flange_a }, z),
+            Body::Rigid(r) => r_point(r, if tip { "b" } else { "a" }, z),
         }
     }
 
     /// World position and angle of the root (flange a) of beam group `g`: the tangent there.
     pub fn beam_root(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
-        let first = self.beams[g].bodies.start;
-        let z = self.body_coords(first, q);
-        match &self.bodies[first] {
-            Body::Beam(b) => b.point(&b.flange_a, z),
-            Body::Rigid(r) => r_point(r, "a", z),
-        }
+        self.flange(self.beams[g].bodies.start, false, q)
     }
 
     /// Transverse displacement of the tip (flange b) of beam group `g` from the tangent at its

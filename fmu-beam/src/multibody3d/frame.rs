@@ -22,6 +22,16 @@ pub enum Frame3 {
     },
 }
 
+/// World position and rotation of the material point `map` of a body with coordinates z:
+/// x = R + A (s0 + S_p q_f), A exp(φ̃) with φ = S_φ q_f.
+pub fn map_pose(map: &SpatialPointMap, z: DVectorView<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+    let (r, _, a) = frame_of(&z);
+    let f = z.rows(FRAME, map.sp.ncols());
+    let s = map.s0 + mul(&map.sp, &f);
+    let phi = mul(&map.sphi, &f);
+    (r + a * s, a * Rotation3::from_scaled_axis(phi).into_inner())
+}
+
 impl Frame3 {
     /// A frame on body `body` at `map`, rotated by `rotation`.
     pub fn on_body(body: usize, map: SpatialPointMap, rotation: Matrix3<f64>) -> Frame3 {
@@ -62,14 +72,8 @@ impl Frame3 {
         match (self, z) {
             (Frame3::World { position, rotation }, _) => (*position, *rotation),
             (Frame3::OnBody { map, rotation, .. }, Some(z)) => {
-                let (r, _, a) = frame_of(&z);
-                let f = z.rows(FRAME, map.sp.ncols());
-                let s = map.s0 + mul(&map.sp, &f);
-                let phi = mul(&map.sphi, &f);
-                (
-                    r + a * s,
-                    a * Rotation3::from_scaled_axis(phi).into_inner() * rotation,
-                )
+                let (r, a) = map_pose(map, z);
+                (r, a * rotation)
             }
             (Frame3::OnBody { .. }, None) => panic!("a body frame needs its body's coordinates"),
         }

@@ -419,20 +419,9 @@ impl System3 {
         force: &Vector3<f64>,
         torque: &Vector3<f64>,
     ) -> Vec<(usize, f64)> {
-        let mut d = Vec::new();
-        let (_, a) = self.frame_pose_derivatives(f, q, &mut d);
-        self.frame_columns(f)
-            .into_iter()
-            .zip(&d)
-            .map(|(k, (dx, da))| {
-                let w = da * a.transpose();
-                let dth = Vector3::new(
-                    w[(2, 1)] - w[(1, 2)],
-                    w[(0, 2)] - w[(2, 0)],
-                    w[(1, 0)] - w[(0, 1)],
-                ) * 0.5;
-                (k, force.dot(dx) + torque.dot(&dth))
-            })
+        let (_, cols) = self.frame_jacobian(f, q);
+        cols.into_iter()
+            .map(|(k, dx, dth)| (k, force.dot(&dx) + torque.dot(&dth)))
             .collect()
     }
 
@@ -465,13 +454,7 @@ impl System3 {
     /// (coordinate, value) pairs; entries of one coordinate add.
     pub fn input_force(&self, q: &DVector<f64>, t: f64, slot: usize) -> Vec<(usize, f64)> {
         use crate::multibody::law::Law;
-        let mut unit = vec![InputValue::default(); self.inputs.len()];
-        unit[slot] = InputValue {
-            value: 1.0,
-            der1: 0.0,
-            der2: 0.0,
-            t0: t,
-        };
+        let unit = InputValue::unit(self.inputs.len(), slot, t);
         let mut out = Vec::new();
         for l in &self.loads {
             let Some(law) = l.law.as_ref().filter(|law| law.law == Law::Input(slot)) else {
@@ -551,9 +534,7 @@ impl System3 {
         let first = self.beams[g].bodies.start;
         let z = self.body_coords(first, q);
         let (r, a) = match &self.bodies[first] {
-            Body3::Beam(b) => {
-                Frame3::on_body(first, b.flange_a.clone(), Matrix3::identity()).pose(Some(z))
-            }
+            Body3::Beam(b) => super::frame::map_pose(&b.flange_a, z),
             _ => {
                 let (r, _, a) = super::body::frame_of(&z);
                 (r, a)
