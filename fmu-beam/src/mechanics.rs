@@ -4,7 +4,7 @@
 
 use crate::effects::Effects;
 use crate::error::EngineError;
-use crate::multibody::equations::{CoordinateKind, Equations};
+use crate::multibody::equations::{CoordinateKind, Equations, Turning};
 use crate::multibody::law::InputValue;
 use crate::multibody::sparsity::{BlockDiagonal, JacobianRows};
 use crate::multibody::System;
@@ -135,5 +135,8 @@ impl Equations for Mechanics {
     }
     fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
         each!(self, s => Equations::power(s, q, v, lambda, t))
+    }
+    fn turning(&self) -> Option<Turning> {
+        each!(self, s => Equations::turning(s))
     }
 }

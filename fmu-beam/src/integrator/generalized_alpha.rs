@@ -13,7 +13,7 @@ use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA};
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::multibody::{CoordinateKind, Equations, JacobianRows};
+use crate::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
 use nalgebra::DVector;
 
 /// The integration state at a step boundary.
@@ -196,6 +196,8 @@ pub struct Stepper {
     /// The iteration matrix, factorized or not.
     matrix: IterationMatrix,
     memory: Memory,
+    /// How the unknowns turn with the whole system, where the equations say.
+    turning: Option<Turning>,
     /// The last fixed step cut short: time, size and why (the engine logs it).
     pub last_split: Option<(f64, f64, SplitReason)>,
     // workspace
@@ -250,6 +252,7 @@ impl Stepper {
             algebraic,
             matrix: IterationMatrix::new(sys, linear),
             memory: Memory::default(),
+            turning: sys.turning(),
             last_split: None,
             gm: sys.jacobian_pattern(),
             r: DVector::zeros(n),
@@ -541,6 +544,34 @@ impl Stepper {
             .factorize(sys, q, v, qdd, lambda, t, c.scaling(h))
     }
 
+    /// Solves for the Newton correction at iterate `q` in `rhs`. Where the bodies have turned
+    /// since the matrix was factorized, by angles δ_b, the matrix is used as if turned by the
+    /// middle of their range ([`Turning`]): a matrix of a spinning or swinging system stays a
+    /// good one over many steps, and no body's mismatch exceeds what it was unturned.
+    fn solve_turned(&mut self, q: &DVector<f64>) -> bool {
+        let delta = match (&self.turning, &self.memory.point) {
+            (Some(turning), Some(p)) if !turning.angles.is_empty() => {
+                let (lo, hi) = turning
+                    .angles
+                    .iter()
+                    .map(|&k| q[k] - p.q[k])
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
+                        (lo.min(d), hi.max(d))
+                    });
+                0.5 * (lo + hi)
+            }
+            _ => 0.0,
+        };
+        if delta == 0.0 || !delta.is_finite() {
+            return self.matrix.solve_mut(&mut self.rhs);
+        }
+        let pairs = &self.turning.as_ref().expect("turned").pairs;
+        turn_pairs(&mut self.rhs, pairs, -delta);
+        let solved = self.matrix.solve_mut(&mut self.rhs);
+        turn_pairs(&mut self.rhs, pairs, delta);
+        solved
+    }
+
     /// Whether the iteration matrix is factorized sparse.
     pub fn is_sparse(&self) -> bool {
         self.matrix.is_sparse()
@@ -629,7 +660,7 @@ impl Stepper {
             for k in 0..m {
                 self.rhs[n + k] = -self.g[k];
             }
-            if !self.matrix.solve_mut(&mut self.rhs) {
+            if !self.solve_turned(&q) {
                 self.forget();
                 return Err(Failure::Singular);
             }
@@ -706,6 +737,16 @@ impl Stepper {
             correction: norm,
             fresh,
         })
+    }
+}
+
+/// Turns each (x, y) pair of `x` starting at the given indices by the angle δ.
+fn turn_pairs(x: &mut DVector<f64>, pairs: &[usize], delta: f64) {
+    let (s, c) = delta.sin_cos();
+    for &i in pairs {
+        let (a, b) = (x[i], x[i + 1]);
+        x[i] = c * a - s * b;
+        x[i + 1] = s * a + c * b;
     }
 }
 

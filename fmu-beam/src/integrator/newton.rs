@@ -28,12 +28,15 @@ pub const STAGNATION: f64 = 10.0;
 /// again at the current iterate, within the step.
 pub const SLOW: f64 = 0.3;
 /// A measured rate slower than this keeps the step but asks for a new iteration matrix for the
-/// next one. A new matrix costs about one Newton iteration (its assembly and sparse or dense
-/// LU) and saves about one per step for many steps. At fixed steps, 0.1 instead of 0.3 takes
-/// C4 Ω = 4 (10 × 1 substructures at 5e-3 s) from 4.5 to 3.2 iterations per step, 0.75 × the
-/// CPU time (40 × 1 at 1e-3 s: 3.6 to 2.8, 0.72 ×), C3 (2e-4 s) from 4.7 to 3.9, 0.80 ×, C2
-/// (5 × 2 at 2e-4 s) from 3.8 to 3.3, 0.90 × (issue 12; fastest of 3 runs).
-pub const STALE: f64 = 0.1;
+/// next one. A new matrix costs a few Newton iterations (its assembly and sparse or dense LU)
+/// and saves up to one per step for many steps. Since Newton turns the matrix with a system that
+/// turns as a whole (`Stepper::solve_turned`), what ages it is slow (a spin rate that changes,
+/// deformation), and a rate above 0.03 is worth replacing. At fixed steps, 0.03 instead of 0.1
+/// (with turning, fastest of 3 runs, issue 12): C4 Ω = 10 (10 × 1 substructures at 5e-3 s)
+/// from 3.04 to 2.73 iterations per step, 0.91 × the CPU time; C4 Ω = 4 (40 × 1 at 1e-3 s,
+/// tolerance 1e-6) 2.84 to 2.72, 0.94 ×; C3 (2e-4 s) 3.74 to 3.37, 0.94 ×; C2 (5 × 2 at
+/// 1e-4 s) 3.13 to 2.91, 0.99 ×.
+pub const STALE: f64 = 0.03;
 
 /// What the monitor says after a correction.
 #[derive(Debug, Clone, Copy, PartialEq)]

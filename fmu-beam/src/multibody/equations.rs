@@ -34,6 +34,20 @@ impl CoordinateKind {
     }
 }
 
+/// Where a planar system's unknowns turn when every body turns by one angle δ about the plane's
+/// normal: the equations are invariant to turning the whole system (up to the tangent of loads
+/// fixed in the world), so the iteration matrix at the turned state is R(δ) S R(δ)ᵀ, with R
+/// turning each (x, y) pair below by δ. Newton keeps a factorized S over steps in which a
+/// spinning or swinging system turns.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Turning {
+    /// Indices in q of the bodies' world angles.
+    pub angles: Vec<usize>,
+    /// First index of each (x, y) pair of world-vector components among the n + m unknowns of
+    /// a Newton correction: the bodies' positions, and the joint rows that hold p₁ - p₀.
+    pub pairs: Vec<usize>,
+}
+
 /// The equations of motion of a constrained mechanical system in index-3 form.
 pub trait Equations {
     /// Number of coordinates.
@@ -138,4 +152,9 @@ pub trait Equations {
     fn joints_of_rows(&self, rows: &[usize]) -> Vec<String>;
     /// Power of drives and loads (W).
     fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64;
+    /// How the unknowns turn with the whole system ([`Turning`]); None where no such
+    /// symmetry is used.
+    fn turning(&self) -> Option<Turning> {
+        None
+    }
 }

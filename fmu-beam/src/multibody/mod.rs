@@ -12,6 +12,6 @@ pub mod sparsity;
 pub mod system;
 pub mod weld;
 
-pub use equations::{CoordinateKind, Equations};
+pub use equations::{CoordinateKind, Equations, Turning};
 pub use sparsity::{BlockDiagonal, JacobianRows};
 pub use system::System;

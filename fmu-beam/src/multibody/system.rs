@@ -4,13 +4,14 @@
 //! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
 
 use super::body::Body;
+use super::equations::Turning;
 use super::frame::{self, Frame, FrameState};
 use super::joint::{Drive, Joint, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
 use super::sparsity::{BlockDiagonal, JacobianRows};
 use crate::beam::planar_beam::TermCounts;
-use crate::beam::planar_beam::{rot, PlanarBeam, PointMap};
+use crate::beam::planar_beam::{rot, PlanarBeam, PointMap, THETA};
 use crate::effects::Effects;
 use crate::error::EngineError;
 use crate::scene::{DriveKind, JointKind, Scene};
@@ -384,6 +385,22 @@ impl System {
     /// Indices in q of the frame coordinates (x, y, θ) of every body, not its deformation.
     pub fn frame_coordinates(&self) -> Vec<usize> {
         self.offsets.iter().flat_map(|&o| o..o + 3).collect()
+    }
+
+    /// The unknowns that turn with the whole system: each body's (x, y) and angle, and the
+    /// p₁ - p₀ rows of revolute and weld joints (the first two of each, along the world axes).
+    pub fn turning(&self) -> Turning {
+        let angles = self.offsets.iter().map(|&o| o + THETA).collect();
+        let mut pairs: Vec<usize> = self.offsets.clone();
+        for j in &self.joints {
+            if matches!(
+                j.kind,
+                JointKind::Weld | JointKind::Revolute | JointKind::Spherical
+            ) {
+                pairs.push(self.n + j.row);
+            }
+        }
+        Turning { angles, pairs }
     }
 
     /// Coordinates of body `i`.
@@ -1014,5 +1031,8 @@ impl super::equations::Equations for System {
     }
     fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
         System::power(self, q, v, lambda, t)
+    }
+    fn turning(&self) -> Option<Turning> {
+        Some(System::turning(self))
     }
 }

@@ -204,9 +204,12 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("3 x 1 substructures", &[Substructures("beam", 3, 1)]),
                 formulation("5 x 1 substructures", &[Substructures("beam", 5, 1)]),
                 formulation("10 x 1 substructures", &[Substructures("beam", 10, 1)]),
-                // 1e-5 needs more: 10 x 1 stops near 1.1e-4 and 20 x 1 near 1.8e-5 whatever
-                // the step; 40 x 1 reaches 8.4e-6 at 5e-4 s
+                // 1e-5 needs more: 10 x 1 stops near 1.1e-4 and 20 x 1 near 1.0-1.5e-5
+                // whatever the step. The counts between the doublings (15, 30), as the peer's
+                // meshes 12 and 24 (bench/peer/sweep.py): 30 x 1 reaches 2.1e-6 at 1e-3 s
+                formulation("15 x 1 substructures", &[Substructures("beam", 15, 1)]),
                 formulation("20 x 1 substructures", &[Substructures("beam", 20, 1)]),
+                formulation("30 x 1 substructures", &[Substructures("beam", 30, 1)]),
                 formulation("40 x 1 substructures", &[Substructures("beam", 40, 1)]),
             ],
             settings: c4_settings,
