@@ -10,7 +10,7 @@
 //!   h²(β - 1/6)(a_{n+1} - a_n)).
 
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
-use super::newton::{Contraction, Verdict, KAPPA};
+use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
 use crate::error::EngineError;
 use crate::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
@@ -705,7 +705,12 @@ impl Stepper {
                     }
                     let err = (c.beta - 1.0 / 6.0).abs() * h * h;
                     let err = self.norm(((&acc - &st.acc) * err).iter(), &q);
-                    if self.memory.contraction.slow() {
+                    let stale = if self.turning.is_some() {
+                        STALE_TURNED
+                    } else {
+                        STALE
+                    };
+                    if self.memory.contraction.slow(stale) {
                         self.forget(); // slow: a new matrix for the next step
                     }
                     return Ok((

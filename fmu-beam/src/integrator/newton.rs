@@ -29,14 +29,20 @@ pub const STAGNATION: f64 = 10.0;
 pub const SLOW: f64 = 0.3;
 /// A measured rate slower than this keeps the step but asks for a new iteration matrix for the
 /// next one. A new matrix costs a few Newton iterations (its assembly and sparse or dense LU)
-/// and saves up to one per step for many steps. Since Newton turns the matrix with a system that
-/// turns as a whole (`Stepper::solve_turned`), what ages it is slow (a spin rate that changes,
-/// deformation), and a rate above 0.03 is worth replacing. At fixed steps, 0.03 instead of 0.1
-/// (with turning, fastest of 3 runs, issue 12): C4 Ω = 10 (10 × 1 substructures at 5e-3 s)
-/// from 3.04 to 2.73 iterations per step, 0.91 × the CPU time; C4 Ω = 4 (40 × 1 at 1e-3 s,
-/// tolerance 1e-6) 2.84 to 2.72, 0.94 ×; C3 (2e-4 s) 3.74 to 3.37, 0.94 ×; C2 (5 × 2 at
-/// 1e-4 s) 3.13 to 2.91, 0.99 ×.
-pub const STALE: f64 = 0.03;
+/// and saves up to one per step for many steps. At fixed steps, 0.1 instead of 0.3 took C4
+/// Ω = 4 (10 × 1 substructures at 5e-3 s) from 4.5 to 3.2 iterations per step, 0.75 × the CPU
+/// time, C3 (2e-4 s) from 4.7 to 3.9, 0.80 ×, C2 (5 × 2 at 2e-4 s) from 3.8 to 3.3, 0.90 ×
+/// (issue 12; fastest of 3 runs). Systems that turn their matrix ([`STALE_TURNED`]) use less.
+pub const STALE: f64 = 0.1;
+/// [`STALE`] for a system whose Newton turns its matrix with it (`Stepper::solve_turned`):
+/// what ages the matrix then is slow (a spin rate that changes, deformation), and a rate above
+/// 0.03 is worth replacing. At fixed steps, 0.03 instead of 0.1 (with turning, fastest of 3
+/// runs, issue 12): C4 Ω = 10 (10 × 1 at 5e-3 s) from 3.04 to 2.73 iterations per step, 0.91 ×
+/// the CPU time; C4 Ω = 4 (40 × 1 at 1e-3 s, tolerance 1e-6) 2.84 to 2.72, 0.94 ×; C3 (2e-4 s)
+/// 3.74 to 3.37, 0.94 ×; C2 (5 × 2 at 1e-4 s) 3.13 to 2.91, 0.99 ×. (On the 3D roll-up at
+/// 5e-4 s and Newton at 1e-10, 0.03 met a step whose fresh matrix did not converge, and a
+/// split step: the 3D system does not turn its matrix and keeps 0.1.)
+pub const STALE_TURNED: f64 = 0.03;
 
 /// What the monitor says after a correction.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,9 +89,10 @@ impl Contraction {
         *self = Contraction::default();
     }
 
-    /// Whether the matrix converges slowly enough to be replaced before the next step.
-    pub fn slow(&self) -> bool {
-        self.theta.is_some_and(|t| t > STALE)
+    /// Whether the matrix converges slowly enough to be replaced before the next step: its
+    /// rate is above `stale` ([`STALE`] or [`STALE_TURNED`]).
+    pub fn slow(&self, stale: f64) -> bool {
+        self.theta.is_some_and(|t| t > stale)
     }
 
     /// Whether the corrections of the current step beyond the second shrink slowly (or grow):
@@ -261,7 +268,7 @@ mod tests {
             c.judge(2, 1.62e-3, 1.8e-3, 0.0, 2, KAPPA, false),
             Verdict::Diverging
         );
-        assert!(c.slow());
+        assert!(c.slow(STALE));
         // growing corrections diverge
         let mut c = Contraction::default();
         c.judge(0, 2e-3, INF, 0.0, 7, KAPPA, false);
