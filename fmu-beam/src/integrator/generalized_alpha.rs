@@ -553,8 +553,8 @@ impl Stepper {
     /// middle of their range ([`Turning`]): a matrix of a spinning or swinging system stays a
     /// good one over many steps, and no body's mismatch exceeds what it was unturned.
     fn solve_turned(&mut self, q: &DVector<f64>) -> bool {
-        let delta = match (&self.turning, &self.memory.point) {
-            (Some(turning), Some(p)) if !turning.angles.is_empty() => {
+        let turned = match (&self.turning, &self.memory.point) {
+            (Some(turning), Some(p)) => {
                 let (lo, hi) = turning
                     .angles
                     .iter()
@@ -562,17 +562,18 @@ impl Stepper {
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
                         (lo.min(d), hi.max(d))
                     });
-                0.5 * (lo + hi)
+                // no bodies: ∞ - ∞, not finite
+                let delta = 0.5 * (lo + hi);
+                (delta != 0.0 && delta.is_finite()).then_some((turning, delta))
             }
-            _ => 0.0,
+            _ => None,
         };
-        if delta == 0.0 || !delta.is_finite() {
+        let Some((turning, delta)) = turned else {
             return self.matrix.solve_mut(&mut self.rhs);
-        }
-        let pairs = &self.turning.as_ref().expect("turned").pairs;
-        turn_pairs(&mut self.rhs, pairs, -delta);
+        };
+        turn_pairs(&mut self.rhs, &turning.pairs, -delta);
         let solved = self.matrix.solve_mut(&mut self.rhs);
-        turn_pairs(&mut self.rhs, pairs, delta);
+        turn_pairs(&mut self.rhs, &turning.pairs, delta);
         solved
     }
 
