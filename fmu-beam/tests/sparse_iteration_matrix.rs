@@ -226,7 +226,8 @@ fn turn_matrix(turning: &Turning, dim: usize, delta: f64) -> DMatrix<f64> {
 /// The planar equations are invariant to turning the whole system (without gravity, whose
 /// tangent is fixed in the world): the iteration matrix at the turned state is R S Rᵀ, to
 /// rounding, for a spinning chain of substructures (a hub drive, welds) and for a rotor of a
-/// rigid hub and a flexible blade on revolute joints; so Newton may use S's factors there (`Stepper::solve_turned`).
+/// rigid hub and a flexible blade on revolute joints; so Newton may use S's factors there
+/// (`Stepper::solve_turned`).
 #[test]
 fn the_iteration_matrix_of_a_turned_system_is_the_turned_matrix() {
     for (file, k, stop) in [

@@ -36,9 +36,9 @@ impl CoordinateKind {
 
 /// Where a planar system's unknowns turn when every body turns by one angle δ about the plane's
 /// normal: the equations are invariant to turning the whole system (up to the tangents of loads
-/// and prismatic axes fixed in the world), so the iteration matrix at the turned state is R(δ) S R(δ)ᵀ, with R
-/// turning each (x, y) pair below by δ. Newton keeps a factorized S over steps in which a
-/// spinning or swinging system turns.
+/// and prismatic axes fixed in the world), so the iteration matrix at the turned state is
+/// R(δ) S R(δ)ᵀ, with R turning each (x, y) pair below by δ. Newton keeps a factorized S over
+/// steps in which a spinning or swinging system turns.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Turning {
     /// Indices in q of the bodies' world angles.

@@ -262,9 +262,6 @@ fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), HarnessEr
     Ok((names, rows))
 }
 
-/// The scene of a formulation at a setting. Fixed steps keep the scene's tolerance (it only
-/// stops Newton, whose error does not pile up over many steps: issue 12); error control keeps
-/// the scene's largest step.
 /// Newton tolerances of the fixed-step runs: the scene's own (1e-6), and 1e-8. At a fixed step
 /// the tolerance bounds only Newton's error, weighted by |q| + the system's length: on C4,
 /// 1e-6 × 8 m is as large as the 1e-5 target of a 0.53 m deflection (40 × 1 substructures at
@@ -280,6 +277,9 @@ fn setting_name(setting: Setting, newton: Option<f64>) -> String {
     }
 }
 
+/// The scene of a formulation at a setting. A fixed step runs Newton at `newton`, or at the
+/// scene's tolerance without it ([`FIXED_STEP_TOLERANCES`]); error control keeps the scene's
+/// largest step.
 pub(super) fn configure(
     base: &Scene,
     f: &Formulation,
