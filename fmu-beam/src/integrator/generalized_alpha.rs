@@ -146,19 +146,6 @@ const LAND: f64 = 1e-6;
 /// A remainder this short (relative to the step) before a landing point takes no implicit step.
 const TINY: f64 = 1e-6;
 
-/// A step-size factor rounded down to a multiple of 1/64. The factor is a power of the error
-/// estimate, and libm's `pow` may round the last bit differently on another platform: rounded,
-/// the step sizes (and with them every decision that follows) are the same bit for bit unless
-/// the factor lies within a last bit of a multiple.
-fn quantized(factor: f64) -> f64 {
-    let q = (factor * 64.0).floor() / 64.0;
-    if q > 0.0 {
-        q
-    } else {
-        factor
-    }
-}
-
 /// The factor on the step size after an accepted step whose controller proposes `grow`.
 fn step_factor(grow: f64) -> f64 {
     let grow = grow.clamp(0.2, MAX_GROWTH);
@@ -217,7 +204,7 @@ impl Controller {
         } else {
             MAX_GROWTH
         };
-        let mut next = h * quantized(step_factor(grow));
+        let mut next = h * step_factor(grow);
         if let Some((cap, left)) = self.cap {
             next = next.min(cap);
             self.cap = (left > 1).then_some((cap, left - 1));
@@ -228,7 +215,7 @@ impl Controller {
     /// The step after a rejected one of size `h` and error norm `err`.
     fn rejected(&mut self, h: f64, err: f64) -> f64 {
         self.recent.clear();
-        h * quantized((0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0))
+        h * (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0)
     }
 
     /// Newton's iteration diverged with a fresh matrix at step `h`.
