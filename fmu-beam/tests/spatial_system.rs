@@ -12,7 +12,7 @@ use fmu_beam::integrator::{initial_state, GaState, Settings, Stats, Stepper};
 use fmu_beam::multibody3d::quaternion::{g_body, rotation};
 use fmu_beam::multibody3d::{JointKind3, RigidBody3, System3};
 use fmu_beam::scene::FrameKind;
-use nalgebra::{DVector, Matrix3, Vector3, Vector4};
+use nalgebra::{Matrix3, Vector3, Vector4};
 
 fn fixed(h: f64) -> Settings {
     Settings {
@@ -246,8 +246,8 @@ fn c5_beam(length: f64, elements: usize, alpha: f64) -> SpatialBeamProps {
 
 /// Case C6 (3D paper §5.2): C5's beam, L = 0.2, revolute about the world y axis at flange a,
 /// horizontal along X, gravity along −Z. `elements = None` gives the rigid twin (same mass,
-/// same inertia of the undeformed beam). Returns the hinge angle at 1 s and its rate.
-fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
+/// same inertia of the undeformed beam). Returns the hinge angle at every `hc` from 0 to 1 s.
+fn c6(elements: Option<usize>, settings: Settings, hc: f64) -> Vec<f64> {
     let props = c5_beam(0.2, elements.unwrap_or(1), 0.0);
     let mut sys = System3::new(Some(Vector3::new(0.0, 0.0, -9.81)));
     // joint axes: z along world y (x0 = X, y0 = −Z)
@@ -269,51 +269,62 @@ fn c6(elements: Option<usize>, settings: Settings) -> (f64, f64) {
         }
     };
     let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, f1, None);
+    let mut angles = Vec::new();
     let mut angle = 0.0;
-    let st = simulate(&sys, settings, 1e-2, 1.0, |st| {
+    simulate(&sys, settings, hc, 1.0, |st| {
         angle = unwrap(angle, sys.joint_coordinate(hinge, &st.q));
+        angles.push(angle);
     });
-    let mut qq = st.q.clone();
-    let h = 1e-7;
-    qq.axpy(h, &st.v, 1.0);
-    let rate = (sys.joint_coordinate(hinge, &qq) - sys.joint_coordinate(hinge, &st.q)) / h;
-    let _: &DVector<f64> = &st.q;
-    (angle, rate)
+    angles
 }
 
 /// The rigid pendulum of C6 exactly: J θ'' = m g c cos θ from rest at θ = 0, with m = ρ A L,
 /// c = L/2 and J = m L²/3 (the bar's inertia about the hinge; Euler–Bernoulli elements carry no
 /// rotary inertia of bending, so neither does the rigid twin), by classical Runge–Kutta at
-/// 1e-5 s (its error is far below 1e-10 rad). Returns θ(1 s) and θ'(1 s).
-fn c6_exact_rigid() -> (f64, f64) {
+/// 1e-5 s (its error is far below 1e-10 rad). Returns θ and θ' at every `hc` (a multiple of
+/// 1e-5 s) from 0 to 1 s.
+fn c6_exact_rigid(hc: f64) -> Vec<(f64, f64)> {
     let (l, g) = (0.2, 9.81);
     let k = 1.5 * g / l; // m g (L/2) / (m L²/3)
     let f = |th: f64| k * th.cos();
     let (mut th, mut w, h) = (0.0f64, 0.0f64, 1e-5);
-    for _ in 0..100_000 {
+    let every = (hc / h).round() as usize;
+    let mut out = vec![(th, w)];
+    for i in 1..=100_000 {
         let (a1, b1) = (w, f(th));
         let (a2, b2) = (w + 0.5 * h * b1, f(th + 0.5 * h * a1));
         let (a3, b3) = (w + 0.5 * h * b2, f(th + 0.5 * h * a2));
         let (a4, b4) = (w + h * b3, f(th + h * a3));
         th += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
         w += h / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4);
+        if i % every == 0 {
+            out.push((th, w));
+        }
     }
-    (th, w)
+    out
 }
 
 /// C6: the flexible pendulum lags the rigid one, by very little (its first bending mode is at
 /// 419 Hz, out of the plane of the swing; in the plane, 5.8 kHz). The lag is measured against
 /// the exact rigid pendulum, not against a simulated rigid twin: the twin's own time error is
 /// larger than the lag (at tolerance 1e-9 the simulated twin is 2.2e-5 rad off the exact angle,
-/// which an earlier version of this test read as a lag of 2.4e-6 s), while the flexible runs,
-/// whose steps the high modes keep small, are converged: two elements move by 8e-9 rad (1e-9 s
-/// of lag) from tolerance 1e-9 to 1e-10 (one element, with larger steps, by 1.4e-7 rad: its
-/// lag is uncertain by 1.5e-8 s). The exact pendulum's J = m L²/3 is the rigid twin's inertia
-/// about the hinge, checked here from the beam's undeformed inertia.
-/// About 40 s in release.
+/// which an earlier version of this test read as a lag of 2.4e-6 s).
+///
+/// The lag is the mean of (θ_exact − θ)/θ'_exact over the last 0.1 s, sampled every 0.2 ms,
+/// not its value at 1 s: the hinge angle carries the in-plane bending vibration the release
+/// excites (±1e-8 s of lag), whose phase at 1 s no affordable run resolves. An earlier version
+/// read the angle at 1 s and asserted that two elements move by less than 2e-8 rad from
+/// tolerance 1e-9 to 1e-10; that held by luck of the step sequence: a change of the step-size
+/// controller that rounds its factors moved the 1e-9 run by 8e-8 rad, and runs at 1e-9 to 1e-12
+/// under three controllers spread over 1.2e-7 rad. The mean lag of two elements, measured:
+/// 4.45e-8 s at tolerance 1e-9, 4.86e-8 at 1e-10, 4.93e-8 at 1e-11 (the same to 1e-11 s under
+/// each controller), so at 1e-10 it is converged in time to about 2 %. The exact pendulum's
+/// J = m L²/3 is the rigid twin's inertia about the hinge, checked here from the beam's
+/// undeformed inertia. About 20 s in release.
 #[test]
 fn c6_flexible_pendulum_lags_its_rigid_twin() {
-    let (exact, rate) = c6_exact_rigid();
+    let hc = 2e-4;
+    let exact = c6_exact_rigid(hc);
     // the rigid twin's inertia about the hinge axis (world y = the beam's y) and its mass
     let props = c5_beam(0.2, 1, 0.0);
     let beam = fmu_beam::beam::spatial_beam::SpatialBeam::new("beam", &props);
@@ -325,33 +336,37 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
         "J = m L²/3: {j_hinge} vs {}",
         m * 0.04 / 3.0
     );
-    println!("C6 exact rigid pendulum at 1 s: {exact:.10} rad, rate {rate:.6} rad/s");
+    let (th, rate) = exact[exact.len() - 1];
+    println!("C6 exact rigid pendulum at 1 s: {th:.10} rad, rate {rate:.6} rad/s");
     let at = |tolerance: f64| Settings {
         adaptive: true,
         tolerance,
         max_step: 1e-3,
         rho_inf: 0.9,
     };
-    let mut lags = Vec::new();
-    for n in [1, 2, 4] {
-        let (a, _) = c6(Some(n), at(1e-9));
-        // the time by which the flexible pendulum trails the rigid one at 1 s
-        let lag = (exact - a) / rate;
-        println!("C6 {n:2} elements: angle {a:.10} rad, phase lag at 1 s {lag:.4e} s");
-        lags.push(lag);
-    }
-    let (tighter, _) = c6(Some(2), at(1e-10));
-    let moved = tighter - (exact - lags[1] * rate);
-    println!("C6  2 elements at tolerance 1e-10: angle moves by {moved:.1e} rad");
+    // the time by which the flexible pendulum trails the rigid one over the last 0.1 s
+    let lag = |elements: usize, tolerance: f64| {
+        let angles = c6(Some(elements), at(tolerance), hc);
+        assert_eq!(angles.len(), exact.len());
+        let from = (0.9 / hc).round() as usize;
+        let lags = (from..angles.len()).map(|i| (exact[i].0 - angles[i]) / exact[i].1);
+        let lag = lags.sum::<f64>() / (angles.len() - from) as f64;
+        println!("C6 {elements} elements at tolerance {tolerance:.0e}: mean lag {lag:.4e} s");
+        lag
+    };
+    let lags: Vec<f64> = [1, 2, 4].iter().map(|&n| lag(n, 1e-10)).collect();
+    let looser = lag(2, 1e-9);
+    let moved = (looser - lags[1]).abs();
+    println!("C6 2 elements, tolerance 1e-9 to 1e-10: the lag moves by {moved:.1e} s");
     assert!(
-        moved.abs() < 2e-8,
-        "the flexible runs are converged in time"
+        moved < 0.15 * lags[1],
+        "the flexible runs are converged in time: {moved:e} s"
     );
     assert!(lags.iter().all(|&l| l > 1e-8), "the flexible pendulum lags");
     assert!(lags.iter().all(|&l| l < 1e-6), "by a little");
     let (d1, d2) = ((lags[1] - lags[0]).abs(), (lags[2] - lags[1]).abs());
     println!("lag changes with elements: 1→2 {d1:.2e} s, 2→4 {d2:.2e} s");
-    assert!(d2 <= d1 + 2e-9, "the lag converges with elements");
+    assert!(d2 < 0.5 * d1, "the lag converges with elements");
 }
 
 /// Case C5 (3D paper §5.1): C5's cantilever (L = 1) in `k` substructures of one element,

@@ -7,7 +7,7 @@ pub mod iteration_matrix;
 pub mod newton;
 
 pub use generalized_alpha::{
-    iteration_scaling, GaState, MatrixPoint, Memory, SplitReason, Stepper,
+    iteration_scaling, Controller, GaState, MatrixPoint, Memory, SplitReason, Stepper,
 };
 pub use initial::initial_state;
 pub use iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
@@ -151,6 +151,19 @@ impl Memory {
                 w.extend_from_slice(&k.to_le_bytes());
             }
         }
+        let c = &self.controller;
+        w.push(c.recent.len() as u8);
+        for e in &c.recent {
+            w.extend_from_slice(&e.to_le_bytes());
+        }
+        match c.cap {
+            None => w.push(0),
+            Some((cap, left)) => {
+                w.push(1);
+                w.extend_from_slice(&cap.to_le_bytes());
+                w.extend_from_slice(&left.to_le_bytes());
+            }
+        }
     }
 
     pub(crate) fn read(r: &mut Reader) -> Result<Memory, EngineError> {
@@ -211,10 +224,32 @@ impl Memory {
         } else {
             None
         };
+        let count = r.u8()? as usize;
+        if count > generalized_alpha::RECENT {
+            return Err(bad("too many remembered step errors"));
+        }
+        let mut recent = Vec::with_capacity(count);
+        for _ in 0..count {
+            let e = r.f64()?;
+            if !(e.is_finite() && e >= 0.0) {
+                return Err(bad("step error not a finite non-negative number"));
+            }
+            recent.push(e);
+        }
+        let cap = if flag(r)? {
+            let cap = r.f64()?;
+            if !(cap.is_finite() && cap > 0.0) {
+                return Err(bad("step cap not a finite positive number"));
+            }
+            Some((cap, r.u32()?))
+        } else {
+            None
+        };
         Ok(Memory {
             point,
             contraction: newton::Contraction::measured(theta, since),
             grid,
+            controller: Controller { recent, cap },
         })
     }
 }
