@@ -86,7 +86,11 @@ def test_the_fmpy_script_gives_the_masters_result(harness, tmp_path):
     np.testing.assert_array_equal(rows[:, 0], ours[:, 0])
     diff = np.abs(rows[:, [2, 3]] - ours[:, [1, 2]]).max()
     print(f"fmpy script against the master: {diff:.2e} m; {stats}")
-    assert diff < 1e-10
+    # The two masters run the same iteration and agree to round-off (1e-14 m) until a step whose
+    # pin mismatch lies within round-off of the 1e-9 m tolerance: one of them iterates once more
+    # there, and from then on they differ by about that tolerance (measured at the scenes'
+    # rho_inf = 0.7: 1e-12 m at 1.054 s, 1.8e-9 m at 1.6 s, two unit steps more in fmpy's run).
+    assert diff < 10 * joint_fmpy.TOLERANCE
 
 
 def test_a_light_hub_couples_where_explicit_gauss_seidel_diverges():

@@ -56,12 +56,18 @@ fn c2_single_frame_and_substructured_agree_and_conserve_energy() {
     );
     println!("tip deformation: max {max_tip:.3e} m; the models differ by up to {worst_tip:.3e} m");
     assert!(worst < 0.01 * swing);
-    // energy: m g L/2 is released by the fall; no damping but the integrator's (rho_inf = 0.9)
+    // energy: m g L/2 is released by the fall; no damping but the integrator's, which takes
+    // energy from the modes its steps do not resolve and creates none beyond the tolerance.
+    // The single frame runs at rho_inf = 0.9, the substructured pendulum at 0.7 (its error
+    // control is cheaper so, issue 12), which damps more: measured 2.4e-6 and 1.5e-5 of
+    // m g L/2 taken, 8e-8 and 4.8e-7 created at most (tolerance 1e-6)
     let scale = 5540.0 * 0.0018 * 0.4 * 9.81 * 0.2;
-    for r in [&a, &b] {
-        let drift = r.column(3).iter().fold(0.0f64, |m, e| m.max(e.abs())) / scale;
-        println!("energy drift {drift:.2e} of m g L/2");
-        assert!(drift < 1e-5);
+    for (r, taken) in [(&a, 1e-5), (&b, 3e-5)] {
+        let high = r.column(3).iter().cloned().fold(f64::MIN, f64::max) / scale;
+        let low = r.column(3).iter().cloned().fold(f64::MAX, f64::min) / scale;
+        println!("energy between {low:.2e} and {high:.2e} of m g L/2");
+        assert!(high < 1e-6, "no energy created");
+        assert!(-low < taken, "little taken");
         assert!(
             r.column(4).iter().cloned().fold(0.0, f64::max) > 0.9 * scale,
             "the pendulum falls"

@@ -13,7 +13,10 @@ const OUTS: [&str; 6] = [
 ];
 
 /// No damping but the integrator's: the work of the drive torque equals kinetic + strain
-/// energy (no gravity), and the rigid-crank variant ends within 1 % of the elastic one.
+/// energy (no gravity), less what the integrator takes from the modes its steps do not resolve
+/// (both scenes at rho_inf = 0.7, issue 12: measured up to 1.2e-4 of the work on the elastic
+/// crank, whose modes the torque's cut-off strikes) and never more; the rigid-crank variant
+/// ends within 1 % of the elastic one.
 #[test]
 fn c3_work_balance_and_rigid_crank_agreement() {
     let elastic = run(scene("slider_crank.toml"), &[], &OUTS, 1e-2, 1.6);
@@ -25,16 +28,16 @@ fn c3_work_balance_and_rigid_crank_agreement() {
         1.6,
     );
     for (name, r) in [("elastic", &elastic), ("rigid crank", &rigid)] {
-        let mut worst: f64 = 0.0;
-        for row in &r.rows {
-            worst = worst.max((row[3] - row[4] - row[5]).abs());
-        }
+        let taken = r.rows.iter().map(|row| row[3] - row[4] - row[5]);
+        let (low, high) = taken.fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
         let w = r.last(3);
         println!(
-            "{name}: work {w:.6e} J, |work - energy| <= {worst:.2e} J ({:.1e} relative)",
-            worst / w
+            "{name}: work {w:.6e} J, work - energy between {low:.2e} and {high:.2e} J ({:.1e} \
+             relative)",
+            high / w
         );
-        assert!(worst < 1e-4 * w);
+        assert!(low > -1e-6 * w, "no energy created");
+        assert!(high < 2.5e-4 * w, "little taken");
     }
     let (se, sr) = (elastic.last(1), rigid.last(1));
     println!("slider at 1.6 s: elastic {se:.6} m, rigid crank {sr:.6} m");

@@ -192,10 +192,22 @@ fn a_fixed_step_is_honoured_and_a_split_is_counted_and_logged() {
     let messages = e.take_messages();
     assert_eq!(messages.len(), 1, "{messages:?}");
     assert!(messages[0].contains("drive law") && messages[0].contains("split_steps"));
-    // the elastic crank at 4e-3 s (967 steps instead of 400 before issue 12)
+    // the elastic crank at 4e-3 s (967 steps instead of 400 before issue 12): at the scene's
+    // rho_inf = 0.7, Newton does not converge on a step or two just after the torque's
+    // cut-off (at 0.9 it did), and those are divided, counted and logged; every other step is
+    // the grid's (measured: 405 steps, 6 of them split)
     let (_, mut e) = run("slider_crank.toml", 4e-3, TOL, 1e-2, 1.6, &[], &[]);
-    assert_eq!(counter(&mut e, "solver.steps"), 400);
-    assert_eq!(counter(&mut e, "solver.split_steps"), 0);
+    let (steps, split) = (
+        counter(&mut e, "solver.steps"),
+        counter(&mut e, "solver.split_steps"),
+    );
+    println!("C3 at 4e-3 s: {steps} steps, {split} split");
+    assert!(split <= 8 && steps - split <= 400, "{steps} steps, {split} split");
+    let messages = e.take_messages();
+    assert!(
+        split == 0 || messages.iter().any(|m| m.contains("Newton")),
+        "{messages:?}"
+    );
     // at 1e-2 s Newton does not converge on a few steps after the torque's cut-off (the
     // crank's modes, struck by the jump, ring at 40 times the step's frequency): they are
     // divided, counted and logged
