@@ -202,7 +202,10 @@ fn a_fixed_step_is_honoured_and_a_split_is_counted_and_logged() {
         counter(&mut e, "solver.split_steps"),
     );
     println!("C3 at 4e-3 s: {steps} steps, {split} split");
-    assert!(split <= 8 && steps - split <= 400, "{steps} steps, {split} split");
+    assert!(
+        split <= 8 && steps - split <= 400,
+        "{steps} steps, {split} split"
+    );
     let messages = e.take_messages();
     assert!(
         split == 0 || messages.iter().any(|m| m.contains("Newton")),

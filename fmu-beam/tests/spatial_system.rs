@@ -308,7 +308,8 @@ fn c6_exact_rigid(hc: f64) -> Vec<(f64, f64)> {
 /// 419 Hz, out of the plane of the swing; in the plane, 5.8 kHz). The lag is measured against
 /// the exact rigid pendulum, not against a simulated rigid twin: the twin's own time error is
 /// larger than the lag (at tolerance 1e-9 the simulated twin is 2.2e-5 rad off the exact angle,
-/// which an earlier version of this test read as a lag of 2.4e-6 s).
+/// which an earlier version of this test read as a lag of 2.4e-6 s; docs/accuracy.md has the
+/// open defect behind it: 3D steps at rho_inf < 1 do not converge as h shrinks).
 ///
 /// The lag is the mean of (θ_exact − θ)/θ'_exact over the last 0.1 s, sampled every 0.2 ms,
 /// not its value at 1 s: the hinge angle carries the in-plane bending vibration the release
@@ -317,7 +318,7 @@ fn c6_exact_rigid(hc: f64) -> Vec<(f64, f64)> {
 /// tolerance 1e-9 to 1e-10; that held by luck of the step sequence: a change of the step-size
 /// controller that rounds its factors moved the 1e-9 run by 8e-8 rad, and runs at 1e-9 to 1e-12
 /// under three controllers spread over 1.2e-7 rad. The mean lag of two elements, measured:
-/// 4.45e-8 s at tolerance 1e-9, 4.86e-8 at 1e-10, 4.93e-8 at 1e-11 (the same to 1e-11 s under
+/// 4.45e-8 s at tolerance 1e-9, 4.86e-8 at 1e-10, 4.93e-8 at 1e-11 (the same to 1e-10 s under
 /// each controller), so at 1e-10 it is converged in time to about 2 %. The exact pendulum's
 /// J = m L²/3 is the rigid twin's inertia about the hinge, checked here from the beam's
 /// undeformed inertia. About 20 s in release.
