@@ -164,6 +164,7 @@ impl Memory {
                 w.extend_from_slice(&left.to_le_bytes());
             }
         }
+        w.extend_from_slice(&self.noise.to_le_bytes());
     }
 
     pub(crate) fn read(r: &mut Reader) -> Result<Memory, EngineError> {
@@ -245,11 +246,16 @@ impl Memory {
         } else {
             None
         };
+        let noise = r.f64()?;
+        if !(noise.is_finite() && noise >= 0.0) {
+            return Err(bad("noise level not a finite non-negative number"));
+        }
         Ok(Memory {
             point,
             contraction: newton::Contraction::measured(theta, since),
             grid,
             controller: Controller { recent, cap },
+            noise,
         })
     }
 }
