@@ -307,9 +307,12 @@ fn c6_exact_rigid(hc: f64) -> Vec<(f64, f64)> {
 /// C6: the flexible pendulum lags the rigid one, by very little (its first bending mode is at
 /// 419 Hz, out of the plane of the swing; in the plane, 5.8 kHz). The lag is measured against
 /// the exact rigid pendulum, not against a simulated rigid twin: the twin's own time error is
-/// larger than the lag (at tolerance 1e-9 the simulated twin is 2.2e-5 rad off the exact angle,
-/// which an earlier version of this test read as a lag of 2.4e-6 s; docs/accuracy.md has the
-/// open defect behind it: 3D steps at rho_inf < 1 do not converge as h shrinks).
+/// larger than the lag (at tolerance 1e-9 the simulated twin was 2.2e-5 rad off the exact angle,
+/// which an earlier version of this test read as a lag of 2.4e-6 s; the defect behind it,
+/// Newton's rounding floor at 1e3 ε, is mended: `fixed_steps_converge_as_they_shrink`). At
+/// fixed steps the lag of two elements now converges too: 6.17e-8, 5.26e-8, 5.08e-8 and 5.03e-8
+/// s at 4e-5, 2e-5, 1.25e-5 and 1e-5 s (ρ∞ = 0.9, Newton at 1e-10; before the mend they
+/// scattered over 4.1–6.2e-8 s and 1.25e-5 s gave −8.5e-8 s).
 ///
 /// The lag is the mean of (θ_exact − θ)/θ'_exact over the last 0.1 s, sampled every 0.2 ms,
 /// not its value at 1 s: the hinge angle carries the in-plane bending vibration the release
