@@ -126,8 +126,15 @@ const NOISE_RATIO: f64 = 0.03;
 /// Corrections up to this multiple of the learned noise count as rounding.
 const NOISE_BAND: f64 = 3.0;
 /// The largest noise level learned (in machine epsilons of the coordinates' size): a slow
-/// correction larger than this is a slow matrix, not noise.
-const NOISE_CEILING: f64 = 1e4;
+/// correction larger than this is a slow matrix, not noise, and the floor stays below the old
+/// 1e3 ε. A fresh matrix is not always quadratic (tangents by differences, a first step far
+/// from its predictor): with 1e4, C2's substructured pendulum took its first step's 0.3 at
+/// 5.9e3 ε for noise and kept a floor of 1.8e4 ε for the whole run, the 3D roll-up learned
+/// 2e3–1e4 ε; its C4 noise is 0.1–32 ε.
+const NOISE_CEILING: f64 = 1e2;
+/// Each new matrix halves the learned noise, so that a level learned once does not hold the
+/// floor up for good; the next noisy correction of a fresh matrix sets it again.
+const NOISE_DECAY: f64 = 0.5;
 /// Largest growth of the step size from one step to the next.
 const MAX_GROWTH: f64 = 5.0;
 /// The step grows only as far as the largest error of this many accepted steps allows (the
@@ -750,7 +757,7 @@ impl Stepper {
                     contraction: Contraction::default(),
                     grid: self.memory.grid,
                     controller: std::mem::take(&mut self.memory.controller),
-                    noise: self.memory.noise,
+                    noise: self.memory.noise * NOISE_DECAY,
                 };
                 fresh = true;
                 k = 0;
