@@ -225,10 +225,10 @@ pub struct Memory {
     pub controller: Controller,
     /// The rounding noise of this system's Newton corrections, in machine epsilons of the
     /// coordinates' size (weighted norm), as last seen with a fresh matrix and shrunk at each
-    /// step since ([`NOISE_DECAY`]); 0 until seen. The
-    /// corrections of a spinning chain of stiff substructures (C4) stop shrinking near 10 ε,
-    /// where a rigid pendulum's go on to 0.1 ε: a ratio measured in that noise is not the
-    /// matrix's rate (taken as one, C4 at 5e-3 s replaced its matrix 253 times instead of 50).
+    /// step since ([`NOISE_DECAY`]); 0 until seen. The corrections of a spinning chain of stiff
+    /// substructures (C4) stop shrinking near 10 ε, where a rigid pendulum's go on to 0.1 ε: a
+    /// ratio measured in that noise is not the matrix's rate (taken as one, C4 at 5e-3 s
+    /// replaced its matrix 253 times instead of 51).
     pub noise: f64,
 }
 
