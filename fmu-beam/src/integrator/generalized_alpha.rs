@@ -755,20 +755,17 @@ impl Stepper {
                     return Err(Failure::Singular);
                 }
                 stats.jacobians += 1;
-                self.memory = Memory {
-                    point: Some(MatrixPoint {
-                        q: q.clone(),
-                        v: v.clone(),
-                        qdd: qdd.clone(),
-                        lambda: lambda.clone(),
-                        t: t_new,
-                        h,
-                    }),
-                    contraction: Contraction::default(),
-                    grid: self.memory.grid,
-                    controller: std::mem::take(&mut self.memory.controller),
-                    noise: self.memory.noise,
-                };
+                // a new matrix: its point, and a rate not yet measured (the grid, the
+                // controller and the noise level are the run's, not the matrix's)
+                self.memory.point = Some(MatrixPoint {
+                    q: q.clone(),
+                    v: v.clone(),
+                    qdd: qdd.clone(),
+                    lambda: lambda.clone(),
+                    t: t_new,
+                    h,
+                });
+                self.memory.contraction.fresh();
                 fresh = true;
                 k = 0;
                 prev = f64::INFINITY;
