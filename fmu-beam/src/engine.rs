@@ -90,7 +90,7 @@ pub struct Engine {
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 /// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
 const STRETCH_LIMIT: f64 = 0.01;
-const STATE_VERSION: u32 = 4;
+const STATE_VERSION: u32 = 5;
 
 impl Engine {
     pub fn new(scene: Scene) -> Engine {
@@ -233,6 +233,7 @@ impl Engine {
             st.acc = qdd.clone();
             st.qdd = qdd;
             st.lambda = lambda;
+            m.stepper.restarted();
             m.state.clone_from(st);
             m.state.t = t0;
         }

@@ -145,14 +145,53 @@ fn c1_adaptive_error_decreases_with_tolerance() {
         "exact {reference:.9e} m; fixed step 1.5625e-5 s: error {:.2e} m",
         (fixed - reference).abs()
     );
+    // the converged run's distance from the linear FE solution (the engine's floating frame
+    // carries terms the linear model does not): an error below it is no measure of the steps
+    let floor = (fixed - reference).abs();
     let mut last = f64::INFINITY;
     for tol in [1e-4, 1e-6, 1e-8] {
         let (tip, steps) = run(c1(10), true, tol, 1e-2, t_end);
         let err = (tip - reference).abs();
         println!("tol {tol:.0e}: tip {tip:.9e} m, error {err:.2e} m, {steps} steps");
-        assert!(err < last, "error did not decrease");
+        assert!(
+            err < last.max(3.0 * floor),
+            "error did not decrease toward the floor"
+        );
         last = err;
     }
     // the tolerance weighs errors against the beam length (2 m): 1e-8 allows ~2e-8 m a step
     assert!(last < 1e-6, "at tolerance 1e-8 the error is {last:e} m");
+}
+
+/// Error control resolves the modes whose amplitude matters at the tolerance, not the mesh's
+/// highest (issue 12, item 5). The released cantilever rings every mode of its mesh with about
+/// its share of the static deflection; refining the mesh from 10 to 40 elements adds modes up
+/// to 16 × higher in frequency and of tiny amplitude. The estimate from the change of the
+/// algorithmic acceleration weighed a mode as ω²h² times its amplitude and followed them: at
+/// tolerance 1e-6 it took 7 223 steps with 10 elements and 18 611 with 40 (errors 5.3e-6 and
+/// 1.1e-6 m). The position-level estimate (third differences, at most 8 × a mode's amplitude)
+/// takes 1 403 and 1 217 (errors 3.1e-7 and 1.3e-5 m: with 40 elements, modes of about 1e-5 m
+/// at the tip are left to their phase error, ρ∞ = 1 here). The bound on the error, 3e-3 of the
+/// 0.01 m amplitude, is about twice the 40-element run's: a tolerance bounds each step's error,
+/// not their sum over 1 300 steps. At equal error the new estimate is not dearer on 40 elements:
+/// 1.1e-6 m cost the old one 18 611 steps, the new one about 15 000 (7 598 steps for 2.4e-6 m at
+/// tolerance 1e-7, 21 614 for 5.9e-7 m at 3e-8).
+#[test]
+fn c1_error_control_does_not_chase_the_mesh_highest_modes() {
+    let t_end = 1.0;
+    let mut steps = Vec::new();
+    for n in [10, 40] {
+        let reference = exact_fe_tip(&c1(n), t_end);
+        let (tip, s) = run(c1(n), true, 1e-6, 1e-2, t_end);
+        let err = (tip - reference).abs();
+        println!("{n} elements: error {err:.2e} m, {s} steps");
+        assert!(err < 3e-5, "{n} elements: error {err:e} m");
+        steps.push(s as f64);
+    }
+    assert!(
+        steps[1] < 1.5 * steps[0],
+        "40 elements take {} steps, 10 take {}",
+        steps[1],
+        steps[0]
+    );
 }

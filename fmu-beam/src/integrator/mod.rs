@@ -165,6 +165,11 @@ impl Memory {
             }
         }
         w.extend_from_slice(&self.noise.to_le_bytes());
+        w.push(self.history.len() as u8);
+        for (t, q) in &self.history {
+            w.extend_from_slice(&t.to_le_bytes());
+            write_vec(w, q.as_slice());
+        }
     }
 
     pub(crate) fn read(r: &mut Reader) -> Result<Memory, EngineError> {
@@ -250,12 +255,31 @@ impl Memory {
         if !(noise.is_finite() && noise >= 0.0) {
             return Err(bad("noise level not a finite non-negative number"));
         }
+        let count = r.u8()? as usize;
+        if count > generalized_alpha::HISTORY {
+            return Err(bad("too many remembered points"));
+        }
+        let mut history: Vec<(f64, nalgebra::DVector<f64>)> = Vec::with_capacity(count);
+        for _ in 0..count {
+            let t = r.f64()?;
+            let q = nalgebra::DVector::from_vec(r.vec()?);
+            let ordered = history
+                .last()
+                .is_none_or(|(t0, q0)| *t0 < t && q0.len() == q.len());
+            if !(t.is_finite() && ordered && q.iter().all(|x| x.is_finite())) {
+                return Err(bad(
+                    "remembered points not finite, in order and of one length",
+                ));
+            }
+            history.push((t, q));
+        }
         Ok(Memory {
             point,
             contraction: newton::Contraction::measured(theta, since),
             grid,
             controller: Controller { recent, cap },
             noise,
+            history,
         })
     }
 }
