@@ -573,6 +573,118 @@ fn cheapest<'a>(
         .min_by(|a, b| a.seconds[0].total_cmp(&b.seconds[0]))
 }
 
+/// The error a point is held to on its output: the largest of its own and of every tighter
+/// setting of its family run with the same formulation (the rule of [`meets`]: an error below
+/// that of a tighter setting is luck).
+fn counted_error(points: &[PeerPoint], p: &PeerPoint) -> f64 {
+    let Some((fam, size)) = family(&p.setting) else {
+        return p.error;
+    };
+    points
+        .iter()
+        .filter(|q| {
+            q.tool == p.tool
+                && q.case == p.case
+                && q.output == p.output
+                && q.formulation == p.formulation
+                && family(&q.setting).is_some_and(|(f, s)| f == fam && s <= size)
+        })
+        .fold(p.error, |e, q| e.max(q.error))
+}
+
+/// Issue 12, item 5: each error-controlled run of ours against the cheapest fixed-step run of
+/// the same formulation (at the default Newton tolerance) that is at least as accurate, errors
+/// counted by [`counted_error`]; per case, the median, least and largest ratio of CPU times,
+/// on the case's first output and on every output (a fixed run then counts only if it is as
+/// accurate on each).
+pub fn error_control_table(cases: &[PeerCase], ours: &[PeerPoint]) -> String {
+    let mut s = String::from(
+        "## Error control against the best fixed step\n\n\
+         Each error-controlled run (every tolerance and formulation swept) against the \
+         cheapest fixed-step run of the same formulation at least as accurate, as the ratio of \
+         their CPU times (median of the timed runs; issue 12 asks for at most 1.5). A run's \
+         error is the largest of its own and of every tighter setting's of its family (the \
+         rule above). `unmatched`: runs no fixed step is as accurate as.\n\n\
+         | case | first output: median (least–largest), runs | every output: median \
+         (least–largest), runs | unmatched (first / every) |\n|---|---|---|---|\n",
+    );
+    let fixed = |p: &PeerPoint| family(&p.setting).is_some_and(|(f, _)| f == "fixed step");
+    let controlled = |p: &PeerPoint| family(&p.setting).is_some_and(|(f, _)| f == "tolerance");
+    for case in cases {
+        let outputs: Vec<&str> = case.outputs.iter().map(|(c, _)| *c).collect();
+        let mine: Vec<&PeerPoint> = ours.iter().filter(|p| p.case == case.name).collect();
+        // (formulation, setting) -> counted errors per output, and the CPU time
+        let runs = |keep: &dyn Fn(&PeerPoint) -> bool| {
+            let mut runs: Vec<(&str, &str, Vec<Option<f64>>, f64)> = Vec::new();
+            for p in mine.iter().filter(|p| keep(p)) {
+                let k = outputs.iter().position(|o| *o == p.output);
+                let Some(k) = k else { continue };
+                let at = runs
+                    .iter()
+                    .position(|r| r.0 == p.formulation && r.1 == p.setting)
+                    .unwrap_or_else(|| {
+                        runs.push((
+                            &p.formulation,
+                            &p.setting,
+                            vec![None; outputs.len()],
+                            p.seconds[0],
+                        ));
+                        runs.len() - 1
+                    });
+                runs[at].2[k] = Some(counted_error(ours, p));
+            }
+            runs
+        };
+        let (fixed_runs, controlled_runs) = (runs(&fixed), runs(&controlled));
+        let mut cells = Vec::new();
+        let mut unmatched = Vec::new();
+        for every in [false, true] {
+            let scored = if every { outputs.len() } else { 1 };
+            let mut ratios = Vec::new();
+            let mut missing = 0;
+            for (form, _, errors, cpu) in &controlled_runs {
+                let best = fixed_runs
+                    .iter()
+                    .filter(|(f, _, e, _)| {
+                        f == form
+                            && (0..scored).all(|k| match (e[k], errors[k]) {
+                                (Some(a), Some(b)) => a <= b,
+                                _ => false,
+                            })
+                    })
+                    .map(|r| r.3)
+                    .min_by(f64::total_cmp);
+                match best {
+                    Some(b) => ratios.push(cpu / b),
+                    None => missing += 1,
+                }
+            }
+            ratios.sort_by(f64::total_cmp);
+            cells.push(match ratios.len() {
+                0 => "-".to_string(),
+                n => {
+                    let median = if n % 2 == 1 {
+                        ratios[n / 2]
+                    } else {
+                        0.5 * (ratios[n / 2 - 1] + ratios[n / 2])
+                    };
+                    format!("{median:.2} ({:.2}–{:.2}), {n}", ratios[0], ratios[n - 1])
+                }
+            });
+            unmatched.push(missing.to_string());
+        }
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            case.name,
+            cells[0],
+            cells[1],
+            unmatched.join(" / ")
+        );
+    }
+    s
+}
+
 /// `ours.csv`-style text of points.
 pub fn csv(points: &[PeerPoint]) -> String {
     let mut s = String::from(
@@ -581,7 +693,7 @@ pub fn csv(points: &[PeerPoint]) -> String {
     for p in points {
         let _ = writeln!(
             s,
-            "{},{},{},\"{}\",{},{:.6e},{:.6e},{:.6e},{:.6e},{}",
+            "{},{},{},\"{}\",\"{}\",{:.6e},{:.6e},{:.6e},{:.6e},{}",
             p.case,
             p.output,
             p.tool,
@@ -658,6 +770,8 @@ pub fn report(
             s += "\n";
         }
     }
+    s += "\n";
+    s += &error_control_table(cases, ours);
     s += "\n## The runs behind each ratio\n\n| case, output | target | fmu-beam | Exudyn |\n|---|---|---|---|\n";
     s += &details;
     s
@@ -711,6 +825,53 @@ mod tests {
     /// The single frame of 6 elements on C2 (measured): its error crosses 1e-5 at tolerance
     /// 1e-6 (4.8e-6) on its way to its floor of 2.3e-5; the cheapest run that stays below
     /// 1e-5 is another formulation's.
+    /// Our points are written so that `--ours-points` reads them back, settings with a comma
+    /// included (it could not: the setting was unquoted).
+    #[test]
+    fn our_points_read_back() {
+        let points = [
+            point(
+                "fmu-beam",
+                "crank 3, rod 8",
+                "fixed step 4.0e-3 s, tolerance 1e-8",
+                1.5e-4,
+                0.01,
+            ),
+            point("fmu-beam", "crank 3, rod 8", "tolerance 1e-6", 4.7e-5, 0.3),
+        ];
+        let path = std::env::temp_dir().join(format!("ours_points_{}.csv", std::process::id()));
+        std::fs::write(&path, csv(&points)).unwrap();
+        let back = read_peer(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(back.len(), 2);
+        for (a, b) in points.iter().zip(&back) {
+            assert_eq!((&a.formulation, &a.setting), (&b.formulation, &b.setting));
+            assert_eq!((a.error, a.seconds), (b.error, b.seconds));
+        }
+    }
+
+    /// Item 5's table: an error-controlled run is set against the cheapest fixed step at least
+    /// as accurate, errors counted with the tighter settings' (a fixed step whose error is
+    /// below a tighter step's is held to the tighter one's).
+    #[test]
+    fn error_control_is_set_against_the_cheapest_fixed_step_as_accurate_for_good() {
+        let points = [
+            point("fmu-beam", "f", "fixed step 4.0e-3 s", 1.3e-4, 0.010),
+            point("fmu-beam", "f", "fixed step 2.0e-3 s", 5.6e-5, 0.020),
+            point("fmu-beam", "f", "fixed step 1.0e-3 s", 7.9e-5, 0.040),
+            point("fmu-beam", "f", "fixed step 2.0e-4 s", 2.5e-5, 0.130),
+            point("fmu-beam", "f", "tolerance 1e-5", 4.0e-4, 0.030),
+            point("fmu-beam", "f", "tolerance 1e-6", 6.0e-5, 0.260),
+        ];
+        // 2e-3 s is held to 1e-3 s's 7.9e-5: tolerance 1e-6 (6e-5) is set against 2e-4 s
+        assert_eq!(counted_error(&points, &points[1]), 7.9e-5);
+        assert_eq!(counted_error(&points, &points[3]), 2.5e-5);
+        let cases: Vec<PeerCase> = cases().into_iter().filter(|c| c.name == "c2").collect();
+        let table = error_control_table(&cases, &points);
+        // ratios 0.030 / 0.010 = 3 and 0.260 / 0.130 = 2: median 2.5
+        assert!(table.contains("| c2 | 2.50 (2.00–3.00), 2 |"), "{table}");
+    }
+
     #[test]
     fn an_error_that_crosses_the_target_on_its_way_to_a_floor_above_does_not_count() {
         let points = [
