@@ -118,8 +118,10 @@ pub struct SolverSpec {
     #[serde(default = "default_adaptive")]
     pub adaptive: bool,
     /// Relative tolerance of the error control and of the Newton iteration, on each coordinate
-    /// against tol × (|q| + the system's length; 1 rad for angles). At a fixed step it bounds only
-    /// Newton's error: set it below the accuracy asked of the outputs.
+    /// against tol × (|q| + the system's length; 1 rad for angles). The local error is estimated
+    /// from the positions, so a vibration whose amplitude is below it is left to `rho_inf`'s
+    /// damping rather than resolved. At a fixed step it bounds only Newton's error: set it below
+    /// the accuracy asked of the outputs.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
