@@ -470,9 +470,11 @@ impl Stepper {
             return None;
         }
         let h = t1 - st.t;
-        let mut e = third_difference([(*t_a, a), (*t_b, b), (*t_c, x), (t1, q1)]);
-        e *= (c.beta - 1.0 / 6.0).abs() * 6.0 * h * h * h;
-        Some(e)
+        let factor = (c.beta - 1.0 / 6.0).abs() * 6.0 * h * h * h;
+        let t = [*t_a, *t_b, *t_c, t1];
+        Some(DVector::from_fn(q1.len(), |k, _| {
+            factor * third_difference(t, [a[k], b[k], x[k], q1[k]])
+        }))
     }
 
     /// Weighted RMS norm of a position-like vector against the tolerance.
@@ -567,7 +569,6 @@ impl Stepper {
                 taylor(st, remaining);
                 st.t = target;
                 self.landed(st.t);
-                self.restarted();
                 if target == bp {
                     restart(sys, st)?;
                 }
@@ -948,18 +949,17 @@ impl Stepper {
     }
 }
 
-/// The third divided difference q[t0, t1, t2, t3] of four points in increasing time, per
-/// coordinate: q'''/6 somewhere in [t0, t3] for a smooth q.
-fn third_difference(p: [(f64, &DVector<f64>); 4]) -> DVector<f64> {
-    let [(t0, q0), (t1, q1), (t2, q2), (t3, q3)] = p;
-    let first = |a: &DVector<f64>, b: &DVector<f64>, dt: f64| (b - a) / dt;
+/// The third divided difference q[t0, t1, t2, t3] of four values at increasing times: q'''/6
+/// somewhere in [t0, t3] for a smooth q.
+fn third_difference(t: [f64; 4], q: [f64; 4]) -> f64 {
+    let first = |i: usize, j: usize, a: f64, b: f64| (b - a) / (t[j] - t[i]);
     let (s01, s12, s23) = (
-        first(q0, q1, t1 - t0),
-        first(q1, q2, t2 - t1),
-        first(q2, q3, t3 - t2),
+        first(0, 1, q[0], q[1]),
+        first(1, 2, q[1], q[2]),
+        first(2, 3, q[2], q[3]),
     );
-    let (s012, s123) = (first(&s01, &s12, t2 - t0), first(&s12, &s23, t3 - t1));
-    first(&s012, &s123, t3 - t0)
+    let (s012, s123) = (first(0, 2, s01, s12), first(1, 3, s12, s23));
+    first(0, 3, s012, s123)
 }
 
 /// Turns each (x, y) pair of `x` starting at the given indices by the angle δ.
@@ -1019,10 +1019,7 @@ mod tests {
     /// acceleration grows as ω²h².
     #[test]
     fn the_third_difference_finds_a_cubic_and_stays_bounded_on_an_unresolved_mode() {
-        let diff = |f: &dyn Fn(f64) -> f64, t: [f64; 4]| {
-            let q = t.map(|t| DVector::from_element(1, f(t)));
-            third_difference([(t[0], &q[0]), (t[1], &q[1]), (t[2], &q[2]), (t[3], &q[3])])[0]
-        };
+        let diff = |f: &dyn Fn(f64) -> f64, t: [f64; 4]| third_difference(t, t.map(f));
         // q''' = 9 of a cubic, from unequal steps
         let cubic = |t: f64| 2.0 - t + 0.5 * t * t + 1.5 * t * t * t;
         assert!((6.0 * diff(&cubic, [0.1, 0.13, 0.2, 0.45]) - 9.0).abs() < 1e-11);
