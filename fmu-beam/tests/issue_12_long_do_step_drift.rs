@@ -192,36 +192,30 @@ fn a_fixed_step_is_honoured_and_a_split_is_counted_and_logged() {
     let messages = e.take_messages();
     assert_eq!(messages.len(), 1, "{messages:?}");
     assert!(messages[0].contains("drive law") && messages[0].contains("split_steps"));
-    // the elastic crank at 4e-3 s (967 steps instead of 400 before issue 12): at the scene's
-    // rho_inf = 0.7, Newton does not converge on a step or two just after the torque's
-    // cut-off (at 0.9 it did), and those are divided, counted and logged; every other step is
-    // the grid's (measured: 405 steps, 6 of them split)
-    let (_, mut e) = run("slider_crank.toml", 4e-3, TOL, 1e-2, 1.6, &[], &[]);
+    // the elastic crank at 4e-3 and 1e-2 s: every step is the grid's. Until the torque's jump
+    // was met through the iteration matrix (`initial::meet_jump`), the crank's modes it strikes
+    // overshot and Newton did not converge on a few steps after the cut-off: 405 steps, 6 of
+    // them split, at 4e-3 s (967 before issue 12), and 8 split at 1e-2 s
+    for (h, grid) in [(4e-3, 400), (1e-2, 160)] {
+        let (_, mut e) = run("slider_crank.toml", h, TOL, 1e-2, 1.6, &[], &[]);
+        let (steps, split) = (
+            counter(&mut e, "solver.steps"),
+            counter(&mut e, "solver.split_steps"),
+        );
+        println!("C3 at {h:e} s: {steps} steps, {split} split");
+        assert_eq!((steps, split), (grid, 0));
+        assert!(e.take_messages().is_empty());
+    }
+    // C4 at 5e-2 s: the hub turns up to 0.5 rad per step, and Newton does not converge at the
+    // full step on most of them after the spin-up: they are divided, counted and logged
+    let (_, mut e) = run("spin_up_omega10.toml", 5e-2, TOL, 0.1, 20.0, &[], &[]);
     let (steps, split) = (
         counter(&mut e, "solver.steps"),
         counter(&mut e, "solver.split_steps"),
     );
-    println!("C3 at 4e-3 s: {steps} steps, {split} split");
+    println!("C4 at 5e-2 s: {steps} steps, {split} split");
     assert!(
-        split <= 8 && steps - split <= 400,
-        "{steps} steps, {split} split"
-    );
-    let messages = e.take_messages();
-    assert!(
-        split == 0 || messages.iter().any(|m| m.contains("Newton")),
-        "{messages:?}"
-    );
-    // at 1e-2 s Newton does not converge on a few steps after the torque's cut-off (the
-    // crank's modes, struck by the jump, ring at 40 times the step's frequency): they are
-    // divided, counted and logged
-    let (_, mut e) = run("slider_crank.toml", 1e-2, TOL, 1e-2, 1.6, &[], &[]);
-    let (steps, split) = (
-        counter(&mut e, "solver.steps"),
-        counter(&mut e, "solver.split_steps"),
-    );
-    println!("C3 at 1e-2 s: {steps} steps, {split} split");
-    assert!(
-        split > 0 && steps - split <= 160,
+        split > 0 && steps - split <= 400,
         "{steps} steps, {split} split"
     );
     let messages = e.take_messages();

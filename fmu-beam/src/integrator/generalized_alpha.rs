@@ -9,6 +9,7 @@
 //! - M. Géradin, A. Cardona (2001), Flexible Multibody Dynamics, §11 (error estimate
 //!   h²(β - 1/6)(a_{n+1} - a_n)).
 
+use super::initial::{self, Equated};
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
@@ -102,6 +103,18 @@ impl Coefficients {
 /// [`Stepper`] factorizes; for timing the factorization alone).
 pub fn iteration_scaling(rho_inf: f64, h: f64) -> Scaling {
     Coefficients::new(rho_inf).scaling(h)
+}
+
+/// How a start or a jump of the applied forces or motions is met before a step of about h
+/// ([`initial::meet_jump`]): through the iteration matrix of that step where ρ∞ < 1, through
+/// the mass matrix at ρ∞ = 1, where the scheme is the trapezoidal rule, which gives a mode
+/// struck at any ωh no energy.
+pub fn jump_scaling(rho_inf: f64, h: f64) -> Scaling {
+    if rho_inf < 1.0 {
+        Coefficients::new(rho_inf).scaling(h)
+    } else {
+        Scaling::MASS
+    }
 }
 
 const MAX_NEWTON: usize = 16;
@@ -425,6 +438,24 @@ impl Stepper {
         self.memory.history.clear();
     }
 
+    /// Meets a jump of a drive law at the state's time, before a step of about `h`
+    /// ([`initial::meet_jump`]): the accelerations change by what the jump changes (without
+    /// this the error order drops to one at the jump), and the trajectory before it is no
+    /// history for the error estimate.
+    fn meet_jump<S: Equations + ?Sized>(
+        &mut self,
+        sys: &S,
+        st: &mut GaState,
+        h: f64,
+    ) -> Result<(), EngineError> {
+        let before = Equated::at(sys, st, st.t * (1.0 - 1e-13) - 1e-13);
+        let after = st.t * (1.0 + 1e-13) + 1e-13;
+        let w = jump_scaling(self.settings.rho_inf, h);
+        initial::meet_jump(sys, st, &before, after, h, w)?;
+        self.restarted();
+        Ok(())
+    }
+
     /// Appends the end (t1, q1) of an accepted step from (t0, q0) to the history of positions,
     /// which starts again at t0 where it does not end there.
     fn remember(&mut self, t0: f64, q0: &DVector<f64>, t1: f64, q1: &DVector<f64>) {
@@ -445,8 +476,10 @@ impl Stepper {
 
     /// The local error of a step from `st` to (t1, q1) per coordinate, |β − 1/6| h³ q''', with
     /// q''' from the third divided difference of the positions at the last [`HISTORY`] points
-    /// and the step's end; `None` where the history does not reach back that far (at the start
-    /// and after a restart).
+    /// and the step's end. Where the history does not reach back that far (the first two steps
+    /// after the start or a restart), the state at the step's start enters as a repeated node
+    /// with its velocity (and, at the restart point itself, its acceleration): a cubic through
+    /// the positions and derivatives since the restart, none from before it.
     ///
     /// Why positions, not the algorithmic accelerations' change (β − 1/6) h² Δa of Géradin and
     /// Cardona: both estimate the same h³ q''' where the motion is resolved, but a mode of
@@ -456,25 +489,38 @@ impl Stepper {
     /// highest modes lead, and an error-controlled run resolved them at their own time scale.
     /// With positions a mode is resolved only where its amplitude matters at the tolerance,
     /// and ρ∞ damps the rest, as at fixed steps (C3's elastic crank after its torque's cut-off).
+    /// The velocity and the acceleration at a restart stay bounded by the positions' scale on
+    /// such a mode (h q' and h² q'' of order A: the jump is met through the iteration matrix,
+    /// [`initial::meet_jump`]), so the first steps after it are estimated on the same footing.
     fn position_error(
         &self,
         st: &GaState,
         t1: f64,
         q1: &DVector<f64>,
         c: &Coefficients,
-    ) -> Option<DVector<f64>> {
-        let [(t_a, a), (t_b, b), (t_c, x)] = self.memory.history.as_slice() else {
-            return None;
+    ) -> DVector<f64> {
+        let history = self.memory.history.as_slice();
+        // the points before the step's start, where the history ends there
+        let earlier = match history.split_last() {
+            Some((last, rest)) if last.0 == st.t && rest.iter().all(|p| p.1.len() == q1.len()) => {
+                rest
+            }
+            _ => &[],
         };
-        if *t_c != st.t || [a, b, x].iter().any(|p| p.len() != q1.len()) {
-            return None;
-        }
         let h = t1 - st.t;
         let factor = (c.beta - 1.0 / 6.0).abs() * 6.0 * h * h * h;
-        let t = [*t_a, *t_b, *t_c, t1];
-        Some(DVector::from_fn(q1.len(), |k, _| {
-            factor * third_difference(t, [a[k], b[k], x[k], q1[k]])
-        }))
+        let tc = st.t;
+        DVector::from_fn(q1.len(), |k, _| {
+            let (qc, q) = (st.q[k], q1[k]);
+            factor
+                * match earlier {
+                    [(ta, a), (tb, b)] => third_difference([*ta, *tb, tc, t1], [a[k], b[k], qc, q]),
+                    [(tb, b)] => {
+                        third_difference_with_velocity([*tb, tc, t1], [b[k], qc, q], st.v[k])
+                    }
+                    _ => third_difference_with_acceleration([tc, t1], [qc, q], st.v[k], st.qdd[k]),
+                }
+        })
     }
 
     /// Weighted RMS norm of a position-like vector against the tolerance.
@@ -570,7 +616,7 @@ impl Stepper {
                 st.t = target;
                 self.landed(st.t);
                 if target == bp {
-                    restart(sys, st)?;
+                    self.meet_jump(sys, st, nominal)?;
                 }
                 if divided_until.is_some_and(|d| d <= st.t) {
                     divided_until = None;
@@ -636,8 +682,7 @@ impl Stepper {
                             }
                         }
                         if last && target == bp {
-                            restart(sys, st)?;
-                            self.restarted();
+                            self.meet_jump(sys, st, h)?;
                         }
                         if last && divided_until == Some(target) {
                             divided_until = None;
@@ -897,13 +942,11 @@ impl Stepper {
                         acc[k] = 0.0;
                         qdd[k] = 0.0;
                     }
-                    let err = match self.position_error(st, t_new, &q, &c) {
-                        Some(e) => self.norm(e.iter(), &q),
-                        // no history: the change of the algorithmic acceleration
-                        None => {
-                            let e = (&acc - &st.acc) * ((c.beta - 1.0 / 6.0).abs() * h * h);
-                            self.norm(e.iter(), &q)
-                        }
+                    let err = if self.settings.adaptive {
+                        let e = self.position_error(st, t_new, &q, &c);
+                        self.norm(e.iter(), &q)
+                    } else {
+                        0.0
                     };
                     let stale = if self.turning.is_some() {
                         STALE_TURNED
@@ -962,6 +1005,23 @@ fn third_difference(t: [f64; 4], q: [f64; 4]) -> f64 {
     first(0, 3, s012, s123)
 }
 
+/// The third divided difference q[t0, t1, t1, t2] of values at three increasing times and the
+/// velocity at the middle one.
+fn third_difference_with_velocity(t: [f64; 3], q: [f64; 3], v1: f64) -> f64 {
+    let s01 = (q[1] - q[0]) / (t[1] - t[0]);
+    let s12 = (q[2] - q[1]) / (t[2] - t[1]);
+    let (s011, s112) = ((v1 - s01) / (t[1] - t[0]), (s12 - v1) / (t[2] - t[1]));
+    (s112 - s011) / (t[2] - t[0])
+}
+
+/// The third divided difference q[t0, t0, t0, t1] of values at two times and the velocity and
+/// acceleration at the first.
+fn third_difference_with_acceleration(t: [f64; 2], q: [f64; 2], v0: f64, a0: f64) -> f64 {
+    let h = t[1] - t[0];
+    let s001 = ((q[1] - q[0]) / h - v0) / h;
+    (s001 - 0.5 * a0) / h
+}
+
 /// Turns each (x, y) pair of `x` starting at the given indices by the angle δ.
 fn turn_pairs(x: &mut DVector<f64>, pairs: &[usize], delta: f64) {
     let (s, c) = delta.sin_cos();
@@ -978,18 +1038,6 @@ fn taylor(st: &mut GaState, h: f64) {
     st.q.axpy(h, &st.v, 1.0);
     st.q.axpy(0.5 * h * h, &st.qdd, 1.0);
     st.v.axpy(h, &st.qdd, 1.0);
-}
-
-/// Restarts the scheme at a jump of a drive law: the accelerations and multipliers become those
-/// of the equations just after the jump, so that the algorithmic acceleration carries no memory
-/// of the forces before it (without this the error order drops to one at the jump).
-fn restart<S: Equations + ?Sized>(sys: &S, st: &mut GaState) -> Result<(), EngineError> {
-    let after = st.t * (1.0 + 1e-13) + 1e-13;
-    let (qdd, lambda) = super::initial::consistent_accelerations(sys, &st.q, &st.v, after)?;
-    st.acc = qdd.clone();
-    st.qdd = qdd;
-    st.lambda = lambda;
-    Ok(())
 }
 
 #[cfg(test)]
@@ -1030,6 +1078,20 @@ mod tests {
         let t = [0.3, 0.3 + h, 0.3 + 2.0 * h, 0.3 + 3.0 * h];
         let estimate = 6.0 * h * h * h * diff(&|t: f64| (omega * t).cos(), t);
         assert!(estimate.abs() <= 8.0 + 1e-9, "{estimate}");
+    }
+
+    /// The first two steps after a restart take the restart point's derivatives as repeated
+    /// nodes: both find a cubic's q''' from unequal steps.
+    #[test]
+    fn the_third_difference_with_derivatives_finds_a_cubic() {
+        let q = |t: f64| 2.0 - t + 0.5 * t * t + 1.5 * t * t * t;
+        let (v, a) = (|t: f64| -1.0 + t + 4.5 * t * t, |t: f64| 1.0 + 9.0 * t);
+        let with_v =
+            third_difference_with_velocity([0.1, 0.13, 0.2], [q(0.1), q(0.13), q(0.2)], v(0.13));
+        assert!((6.0 * with_v - 9.0).abs() < 1e-10, "{with_v}");
+        let with_a =
+            third_difference_with_acceleration([0.13, 0.2], [q(0.13), q(0.2)], v(0.13), a(0.13));
+        assert!((6.0 * with_a - 9.0).abs() < 1e-10, "{with_a}");
     }
 
     /// After Newton's iteration diverged at h, the steps stay below 0.9 h for

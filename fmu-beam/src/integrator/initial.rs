@@ -74,12 +74,14 @@ pub fn initial_state<S: Equations + ?Sized>(
             iterations += 1;
         }
     }
-    let (qdd, lambda) = consistent_accelerations(sys, &q, &v, t0)?;
     let h = if settings.adaptive {
         settings.max_step.min(1e-3)
     } else {
         settings.max_step
     };
+    // the scene's loads and motions start at t0: a jump from none, met as the first step meets it
+    let w = super::generalized_alpha::jump_scaling(settings.rho_inf, h);
+    let (qdd, lambda) = consistent_accelerations(sys, &q, &v, t0, w)?;
     Ok(GaState {
         t: t0,
         h,
@@ -123,13 +125,16 @@ fn check_rank<S: Equations + ?Sized>(
     })
 }
 
-/// Solves [[M, Gᵀ], [G, 0]] [q''; λ] = [-r(q, q', 0); -bias], dense or sparse by the system's
+/// Solves [[S, Gᵀ], [G, 0]] [q''; c_m λ] = [-c_m r(q, q', 0); -bias] with S = c_m M + c_c C +
+/// d K as `w` says: the mass matrix alone (the accelerations the equations give) or the
+/// iteration matrix of the first step ([`meet_jump`] says why); dense or sparse by the system's
 /// size ([`LinearSolver::Auto`]).
 pub fn consistent_accelerations<S: Equations + ?Sized>(
     sys: &S,
     q: &DVector<f64>,
     v: &DVector<f64>,
     t: f64,
+    w: Scaling,
 ) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
     let (n, m) = (sys.n(), sys.m());
     let mut r = DVector::zeros(n);
@@ -137,14 +142,9 @@ pub fn consistent_accelerations<S: Equations + ?Sized>(
     let mut bias = DVector::zeros(m);
     sys.accel_bias(q, v, t, &mut bias);
     let mut x = DVector::zeros(n + m);
-    x.rows_mut(0, n).copy_from(&(-r));
+    x.rows_mut(0, n).copy_from(&(-w.cm * r));
     x.rows_mut(n, m).copy_from(&(-bias));
     let mut matrix = IterationMatrix::new(sys, LinearSolver::Auto);
-    let w = Scaling {
-        d: 0.0,
-        cm: 1.0,
-        cc: 0.0,
-    };
     let (zero_n, zero_m) = (DVector::zeros(n), DVector::zeros(m));
     let solved = matrix.factorize(sys, q, v, &zero_n, &zero_m, t, w)
         && matrix.solve_mut(&mut x)
@@ -157,5 +157,73 @@ pub fn consistent_accelerations<S: Equations + ?Sized>(
             ),
         });
     }
-    Ok((x.rows(0, n).into_owned(), x.rows(n, m).into_owned()))
+    Ok((x.rows(0, n).into_owned(), x.rows(n, m) / w.cm))
+}
+
+/// What a jump of the applied forces or motions changes at a state: the bodies' residual
+/// r(q, q', q'', t) (without the reactions) and the constraints' acceleration bias.
+#[derive(Debug, Clone)]
+pub struct Equated {
+    r: DVector<f64>,
+    bias: DVector<f64>,
+}
+
+impl Equated {
+    /// The equations' values at the state's (q, q', q'') at time `t`.
+    pub fn at<S: Equations + ?Sized>(sys: &S, st: &GaState, t: f64) -> Equated {
+        let mut r = DVector::zeros(sys.n());
+        sys.body_residual(&st.q, &st.v, &st.qdd, t, &mut r);
+        let mut bias = DVector::zeros(sys.m());
+        sys.accel_bias(&st.q, &st.v, t, &mut bias);
+        Equated { r, bias }
+    }
+}
+
+/// Meets a jump of the applied forces or motions at `st` (the equations were `before`, and are
+/// those at `t_after`) before a step of about `h`: the accelerations, the algorithmic ones and
+/// the multipliers change by the solution of [[S, Gᵀ], [G, 0]] [Δq''; c_m Δλ] = [−c_m Δr;
+/// −Δbias], with S the iteration matrix of the step to come (`w`: c_m M + c_c C + d K), not the
+/// mass matrix.
+///
+/// Why not the mass matrix (the consistent accelerations): a jump strikes every mode of a
+/// flexible body, each with an amplitude A near its share of the static deflection, and M⁻¹
+/// gives it the acceleration ω²A. Generalized-α fed h²a = (ωh)²A at ωh ≫ 1 overshoots by that
+/// factor: its velocity grows to about (ωh)² A/h in the steps after (a scalar mode struck at
+/// ωh = 300 peaks at 99 × its energy at ρ∞ = 0.7, 9 × at 0.9), and holds it for tens of steps
+/// while ρ∞ damps it. C3's elastic crank at a fixed 4e-3 s held 13 % of the drive's work more
+/// than it was given after the torque's cut-off, 58 % at 1e-2 s. Through S a mode the step
+/// resolves (ωh ≪ 1) takes the same acceleration to O((ωh)²), which keeps the scheme's order,
+/// and one it does not takes at most A/(c h²) (c = d/(c_m h²)): the scheme then starts inside
+/// the range it damps, and no mode gains energy at any ωh or ρ∞ (scalar modes, ωh 0.1 to 1e4,
+/// ρ∞ 0 to 0.99). Only the jump is solved for: what did not jump keeps its accelerations, the
+/// algorithmic one's lag included.
+pub fn meet_jump<S: Equations + ?Sized>(
+    sys: &S,
+    st: &mut GaState,
+    before: &Equated,
+    t_after: f64,
+    h: f64,
+    w: Scaling,
+) -> Result<(), EngineError> {
+    let (n, m) = (sys.n(), sys.m());
+    let after = Equated::at(sys, st, t_after);
+    let mut x = DVector::zeros(n + m);
+    for i in 0..n {
+        x[i] = -w.cm * (after.r[i] - before.r[i]);
+    }
+    for k in 0..m {
+        x[n + k] = -(after.bias[k] - before.bias[k]);
+    }
+    let mut matrix = IterationMatrix::new(sys, LinearSolver::Auto);
+    let solved = matrix.factorize(sys, &st.q, &st.v, &st.qdd, &st.lambda, t_after, w)
+        && matrix.solve_mut(&mut x)
+        && x.iter().all(|v| v.is_finite());
+    if !solved {
+        return Err(EngineError::SingularMatrix { t: st.t, h });
+    }
+    let jump = x.rows(0, n);
+    st.qdd += jump;
+    st.acc += jump;
+    st.lambda.axpy(1.0 / w.cm, &x.rows(n, m).into_owned(), 1.0);
+    Ok(())
 }

@@ -52,6 +52,15 @@ pub struct Scaling {
     pub cc: f64,
 }
 
+impl Scaling {
+    /// The mass matrix alone: [[M, Gᵀ], [G, 0]].
+    pub const MASS: Scaling = Scaling {
+        d: 0.0,
+        cm: 1.0,
+        cc: 0.0,
+    };
+}
+
 /// The iteration matrix's workspace (sized once per system) and its factors.
 #[derive(Debug, Clone)]
 pub struct IterationMatrix {
