@@ -206,14 +206,12 @@ impl Engine {
     }
 
     /// Copies the input values and derivatives into the system, held from time t0. An input
-    /// that changed is a jump of the applied forces or motions at t0: the scheme restarts there
-    /// from the consistent accelerations and multipliers, the mass matrix's (not met through the
-    /// iteration matrix as a drive law's jump is, `Stepper::meet_jump`): a master that couples
-    /// units at the acceleration level computes the inputs from the unit's accelerations and
-    /// directional derivatives, which are the mass matrix's, and the step must start from what
-    /// the master saw (a hinged blade coupled to a light hub by the harness's joint coupling
-    /// drifted 2.8e-2 rad from its monolithic twin otherwise, 2e-6 rad so).
-    fn sync_inputs(&mut self, t0: f64) -> Result<(), EngineError> {
+    /// that changed is a jump of the applied forces or motions at t0. The scheme restarts there
+    /// from the mass matrix's consistent accelerations with the inputs the last step ended with
+    /// (what a master that couples units at the acceleration level saw through the unit's
+    /// outputs and directional derivatives), and meets the jump from them through the iteration
+    /// matrix of the step to come, as a drive law's jump (`Stepper::meet_jump`).
+    fn sync_inputs(&mut self, t0: f64, h: f64) -> Result<(), EngineError> {
         let Some(m) = &mut self.model else {
             return Ok(());
         };
@@ -232,7 +230,23 @@ impl Engine {
         if crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system) {
             // a unit with inputs lands on every communication point: its front is the state
             let st = &mut m.front;
+            // the inputs as the last step ended them (set_real wrote the new ones in already)
+            let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
+                m.applied_inputs
+                    .chunks(3)
+                    .map(|e| InputValue {
+                        value: e[0],
+                        der1: e[1],
+                        der2: e[2],
+                        t0: st.t,
+                    })
+                    .collect()
+            } else {
+                m.system.inputs().to_vec()
+            };
+            // just after t, as the jump is met (a drive law's jump at t is behind the state)
             let after = st.t * (1.0 + 1e-13) + 1e-13;
+            let next = std::mem::replace(m.system.inputs_mut(), ended);
             let (qdd, lambda) = integrator::initial::consistent_accelerations(
                 &m.system,
                 &st.q,
@@ -243,7 +257,16 @@ impl Engine {
             st.acc = qdd.clone();
             st.qdd = qdd;
             st.lambda = lambda;
-            m.stepper.restarted();
+            let before = integrator::initial::Equated::at(&m.system, st, after);
+            *m.system.inputs_mut() = next;
+            let set = m.stepper.settings;
+            let step = if set.adaptive {
+                st.h.min(set.max_step)
+            } else {
+                set.max_step
+            };
+            m.stepper
+                .meet_jump_from(&m.system, st, &before, step.min(h))?;
             m.state.clone_from(st);
             m.state.t = t0;
         }
@@ -546,7 +569,7 @@ impl Engine {
             });
         }
         self.built()?;
-        self.sync_inputs(now)?;
+        self.sync_inputs(now, h)?;
         let m = self.model.as_mut().expect("built above");
         let saved = m.save();
         let mut result = m.advance(now + h);

@@ -59,8 +59,8 @@ fn c2_single_frame_and_substructured_agree_and_conserve_energy() {
     // energy: m g L/2 is released by the fall; no damping but the integrator's, which takes
     // energy from the modes its steps do not resolve and creates none beyond the tolerance.
     // The single frame runs at rho_inf = 0.9, the substructured pendulum at 0.7 (its error
-    // control is cheaper so, issue 12), which damps more: measured 3.8e-6 and 1.7e-5 of
-    // m g L/2 taken, none and 9.5e-7 created at most (tolerance 1e-6: error control varies the
+    // control is cheaper so, issue 12), which damps more: measured 4.4e-6 and 1.5e-5 of
+    // m g L/2 taken, none and 7.0e-7 created at most (tolerance 1e-6: error control varies the
     // step, and generalized-α with a varying step is not dissipative; docs/accuracy.md)
     let scale = 5540.0 * 0.0018 * 0.4 * 9.81 * 0.2;
     for (r, taken) in [(&a, 1e-5), (&b, 3e-5)] {
