@@ -634,9 +634,7 @@ impl Stepper {
             // a leftover of rounding, or a sliver before a point to land on, is no implicit
             // step: an explicit Taylor step of that length is exact to its order
             if remaining <= TINY * nominal {
-                taylor(st, remaining);
-                st.t = target;
-                self.landed(st.t);
+                self.slide(st, target);
                 if target == bp {
                     self.meet_jump(sys, st, nominal)?;
                 }
@@ -779,12 +777,17 @@ impl Stepper {
             .copied()
             .find(|&b| b > st.t && b <= st.t + TINY * set.max_step)
         {
-            taylor(st, b - st.t);
-            st.t = b;
-            self.landed(st.t);
+            self.slide(st, b);
             self.meet_jump(sys, st, set.max_step)?;
         }
         Ok(back.filter(|_| st.t > t_end))
+    }
+
+    /// Takes `st` to `t`, a sliver ahead, by an explicit Taylor step, and lands there.
+    fn slide(&mut self, st: &mut GaState, t: f64) {
+        taylor(st, t - st.t);
+        st.t = t;
+        self.landed(t);
     }
 
     /// A fixed-step run landed on `t` off its grid: the grid goes on from there.
