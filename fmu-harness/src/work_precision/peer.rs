@@ -592,11 +592,32 @@ fn counted_error(points: &[PeerPoint], p: &PeerPoint) -> f64 {
         .fold(p.error, |e, q| e.max(q.error))
 }
 
+/// One run of ours in item 5's table: its formulation and setting, its counted error on each
+/// of the case's outputs (None where it has none), CPU time (median) and steps.
+struct Run<'a> {
+    formulation: &'a str,
+    setting: &'a str,
+    errors: Vec<Option<f64>>,
+    cpu: f64,
+    steps: i64,
+}
+
+impl Run<'_> {
+    /// Whether it is at least as accurate as `other` on the first `scored` outputs.
+    fn as_accurate_as(&self, other: &Run, scored: usize) -> bool {
+        (0..scored).all(|k| match (self.errors[k], other.errors[k]) {
+            (Some(a), Some(b)) => a <= b,
+            _ => false,
+        })
+    }
+}
+
 /// Issue 12, item 5: each error-controlled run of ours against the cheapest fixed-step run of
 /// the same formulation (at the default Newton tolerance) that is at least as accurate, errors
 /// counted by [`counted_error`]; per case, the median, least and largest ratio of CPU times,
 /// on the case's first output and on every output (a fixed run then counts only if it is as
-/// accurate on each).
+/// accurate on each). Then, per run on the first output, the fixed step it is set against:
+/// which runs decide a median.
 pub fn error_control_table(cases: &[PeerCase], ours: &[PeerPoint]) -> String {
     let mut s = String::from(
         "## Error control against the best fixed step\n\n\
@@ -608,30 +629,35 @@ pub fn error_control_table(cases: &[PeerCase], ours: &[PeerPoint]) -> String {
          | case | first output: median (least–largest), runs | every output: median \
          (least–largest), runs | unmatched (first / every) |\n|---|---|---|---|\n",
     );
+    let mut details = String::from(
+        "\n### The runs behind it (first output)\n\n\
+         | case | formulation | setting | error | steps | CPU s | set against | its error | \
+         its steps | its CPU s | ratio |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
     let fixed = |p: &PeerPoint| family(&p.setting).is_some_and(|(f, _)| f == "fixed step");
     let controlled = |p: &PeerPoint| family(&p.setting).is_some_and(|(f, _)| f == "tolerance");
     for case in cases {
         let outputs: Vec<&str> = case.outputs.iter().map(|(c, _)| *c).collect();
         let mine: Vec<&PeerPoint> = ours.iter().filter(|p| p.case == case.name).collect();
-        // (formulation, setting) -> counted errors per output, and the CPU time
         let runs = |keep: &dyn Fn(&PeerPoint) -> bool| {
-            let mut runs: Vec<(&str, &str, Vec<Option<f64>>, f64)> = Vec::new();
+            let mut runs: Vec<Run> = Vec::new();
             for p in mine.iter().filter(|p| keep(p)) {
                 let k = outputs.iter().position(|o| *o == p.output);
                 let Some(k) = k else { continue };
                 let at = runs
                     .iter()
-                    .position(|r| r.0 == p.formulation && r.1 == p.setting)
+                    .position(|r| r.formulation == p.formulation && r.setting == p.setting)
                     .unwrap_or_else(|| {
-                        runs.push((
-                            &p.formulation,
-                            &p.setting,
-                            vec![None; outputs.len()],
-                            p.seconds[0],
-                        ));
+                        runs.push(Run {
+                            formulation: &p.formulation,
+                            setting: &p.setting,
+                            errors: vec![None; outputs.len()],
+                            cpu: p.seconds[0],
+                            steps: p.steps,
+                        });
                         runs.len() - 1
                     });
-                runs[at].2[k] = Some(counted_error(ours, p));
+                runs[at].errors[k] = Some(counted_error(ours, p));
             }
             runs
         };
@@ -642,21 +668,48 @@ pub fn error_control_table(cases: &[PeerCase], ours: &[PeerPoint]) -> String {
             let scored = if every { outputs.len() } else { 1 };
             let mut ratios = Vec::new();
             let mut missing = 0;
-            for (form, _, errors, cpu) in &controlled_runs {
+            for run in &controlled_runs {
                 let best = fixed_runs
                     .iter()
-                    .filter(|(f, _, e, _)| {
-                        f == form
-                            && (0..scored).all(|k| match (e[k], errors[k]) {
-                                (Some(a), Some(b)) => a <= b,
-                                _ => false,
-                            })
-                    })
-                    .map(|r| r.3)
-                    .min_by(f64::total_cmp);
+                    .filter(|f| f.formulation == run.formulation && f.as_accurate_as(run, scored))
+                    .min_by(|a, b| a.cpu.total_cmp(&b.cpu));
+                let error = |r: &Run| r.errors[0].map_or("-".into(), |e| format!("{e:.2e}"));
                 match best {
-                    Some(b) => ratios.push(cpu / b),
-                    None => missing += 1,
+                    Some(b) => {
+                        ratios.push(run.cpu / b.cpu);
+                        if !every {
+                            let _ = writeln!(
+                                details,
+                                "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {:.4} | {:.2} |",
+                                case.name,
+                                run.formulation,
+                                run.setting,
+                                error(run),
+                                run.steps,
+                                run.cpu,
+                                b.setting,
+                                error(b),
+                                b.steps,
+                                b.cpu,
+                                run.cpu / b.cpu
+                            );
+                        }
+                    }
+                    None => {
+                        missing += 1;
+                        if !every {
+                            let _ = writeln!(
+                                details,
+                                "| {} | {} | {} | {} | {} | {:.4} | unmatched | | | | |",
+                                case.name,
+                                run.formulation,
+                                run.setting,
+                                error(run),
+                                run.steps,
+                                run.cpu
+                            );
+                        }
+                    }
                 }
             }
             ratios.sort_by(f64::total_cmp);
@@ -682,7 +735,7 @@ pub fn error_control_table(cases: &[PeerCase], ours: &[PeerPoint]) -> String {
             unmatched.join(" / ")
         );
     }
-    s
+    s + &details
 }
 
 /// `ours.csv`-style text of points.
@@ -870,6 +923,13 @@ mod tests {
         let table = error_control_table(&cases, &points);
         // ratios 0.030 / 0.010 = 3 and 0.260 / 0.130 = 2: median 2.5
         assert!(table.contains("| c2 | 2.50 (2.00–3.00), 2 |"), "{table}");
+        // and each run with the fixed step it is set against
+        assert!(
+            table.contains("| c2 | f | tolerance 1e-6 | 6.00e-5 |")
+                && table.contains("| fixed step 2.0e-4 s | 2.50e-5 |")
+                && table.contains("| 2.00 |\n"),
+            "{table}"
+        );
     }
 
     #[test]
