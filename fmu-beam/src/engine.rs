@@ -20,14 +20,15 @@ struct Model {
     system: Mechanics,
     /// The state at the current communication point.
     state: GaState,
-    /// The integrator's own state, at the end of its last step; a unit without inputs steps
-    /// across communication points, so it may lie past `state`.
+    /// The integrator's own state, at the end of its last step; a unit steps across
+    /// communication points (one with inputs while they go on as extrapolated), so it may lie
+    /// past `state`.
     front: GaState,
     /// The state at the start of the integrator's last step, when that step ends past the
     /// communication point: `state` is interpolated between it and `front`.
     back: Option<GaState>,
-    /// Whether the unit has inputs: then every step lands on the communication points, where
-    /// the master may change them.
+    /// Whether the next steps land on the communication point: a unit whose inputs changed at
+    /// the last one, where the master may change them again (`Engine::sync_inputs`).
     lands: bool,
     stats: Stats,
     stepper: Stepper,
@@ -211,6 +212,13 @@ impl Engine {
     /// (what a master that couples units at the acceleration level saw through the unit's
     /// outputs and directional derivatives), and meets the jump from them through the iteration
     /// matrix of the step to come, as a drive law's jump (`Stepper::meet_jump`).
+    ///
+    /// Where the inputs go on exactly as the last step extrapolated them (a held input, or
+    /// one the master leaves alone), the unit steps past the end of this communication step as
+    /// a unit without inputs does, so that its run does not depend on how the master cuts time;
+    /// where any of them changed, it lands there, the master being likely to change them again.
+    /// An input that changes while the integrator is past this point has its last step redone
+    /// with the inputs as they were, to land here.
     fn sync_inputs(&mut self, t0: f64, h: f64) -> Result<(), EngineError> {
         let Some(m) = &mut self.model else {
             return Ok(());
@@ -227,9 +235,11 @@ impl Engine {
             }
         }
         let applied = flat_inputs(&m.system);
-        if crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system) {
-            // a unit with inputs lands on every communication point: its front is the state
-            let st = &mut m.front;
+        let changed = crate::interface::inputs_changed(&m.applied_inputs, &applied);
+        m.lands = !applied.is_empty() && changed;
+        let jump = crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system);
+        let past = m.front.t > t0 + 1e-6 * m.stepper.settings.max_step;
+        if jump || (changed && past) {
             // the inputs as the last step ended them (set_real wrote the new ones in already)
             let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
                 m.applied_inputs
@@ -238,37 +248,16 @@ impl Engine {
                         value: e[0],
                         der1: e[1],
                         der2: e[2],
-                        t0: st.t,
+                        t0,
                     })
                     .collect()
             } else {
                 m.system.inputs().to_vec()
             };
-            // just after t, as the jump is met (a drive law's jump at t is behind the state)
-            let after = st.t * (1.0 + 1e-13) + 1e-13;
             let next = std::mem::replace(m.system.inputs_mut(), ended);
-            let (qdd, lambda) = integrator::initial::consistent_accelerations(
-                &m.system,
-                &st.q,
-                &st.v,
-                after,
-                integrator::Scaling::MASS,
-            )?;
-            st.acc = qdd.clone();
-            st.qdd = qdd;
-            st.lambda = lambda;
-            let before = integrator::initial::Equated::at(&m.system, st, after);
+            let result = m.meet_inputs(t0, h, jump, &next);
             *m.system.inputs_mut() = next;
-            let set = m.stepper.settings;
-            let step = if set.adaptive {
-                st.h.min(set.max_step)
-            } else {
-                set.max_step
-            };
-            m.stepper
-                .meet_jump_from(&m.system, st, &before, step.min(h))?;
-            m.state.clone_from(st);
-            m.state.t = t0;
+            result?;
         }
         m.applied_inputs = applied;
         Ok(())
@@ -568,11 +557,14 @@ impl Engine {
                 ),
             });
         }
-        self.built()?;
-        self.sync_inputs(now, h)?;
+        // what the master saw at `now`: a failed step gives it back, also where the inputs'
+        // change had the integrator land on `now` from past it first
+        let saved = self.built()?.save();
+        let mut result = self.sync_inputs(now, h);
         let m = self.model.as_mut().expect("built above");
-        let saved = m.save();
-        let mut result = m.advance(now + h);
+        if result.is_ok() {
+            result = m.advance(now + h);
+        }
         if result.is_ok() {
             result = self.monitor_validity();
         }
@@ -806,6 +798,70 @@ impl Engine {
 }
 
 impl Model {
+    /// At the communication point t0, with the system's inputs as the last step ended them and
+    /// `next` the ones set for the step to come: lands the integrator on t0 if it stepped past
+    /// it (its last step redone from the state before it), and where the inputs jump, restarts
+    /// the scheme from the consistent accelerations there and meets the jump to `next`. The
+    /// front is replaced only when all of it succeeded.
+    fn meet_inputs(
+        &mut self,
+        t0: f64,
+        h: f64,
+        jump: bool,
+        next: &[InputValue],
+    ) -> Result<(), EngineError> {
+        let set = self.stepper.settings;
+        let snap = 1e-6 * set.max_step;
+        let mut st = if self.front.t > t0 + snap {
+            let Some(back) = self.back.as_ref().filter(|b| b.t <= t0) else {
+                return Err(EngineError::BadState {
+                    message: format!(
+                        "the integrator is at t = {} s past the communication point {t0} s \
+                         without the state before its last step",
+                        self.front.t
+                    ),
+                });
+            };
+            let mut st = back.clone();
+            self.stepper
+                .step_to(&self.system, &mut st, &mut self.stats, t0)?;
+            st
+        } else {
+            self.front.clone()
+        };
+        if jump {
+            // just after t, as the jump is met (a drive law's jump at t is behind the state)
+            let after = st.t * (1.0 + 1e-13) + 1e-13;
+            let (qdd, lambda) = integrator::initial::consistent_accelerations(
+                &self.system,
+                &st.q,
+                &st.v,
+                after,
+                integrator::Scaling::MASS,
+            )?;
+            st.acc = qdd.clone();
+            st.qdd = qdd;
+            st.lambda = lambda;
+            let before = integrator::initial::Equated::at(&self.system, &st, after);
+            let ended = std::mem::replace(self.system.inputs_mut(), next.to_vec());
+            let step = if set.adaptive {
+                st.h.min(set.max_step)
+            } else {
+                set.max_step
+            };
+            let met = self
+                .stepper
+                .meet_jump_from(&self.system, &mut st, &before, step.min(h));
+            *self.system.inputs_mut() = ended;
+            met?;
+        }
+        self.front = st;
+        self.back = None;
+        self.state.clone_from(&self.front);
+        self.state.t = t0;
+        Ok(())
+    }
+
     fn save(&self) -> ModelState {
         ModelState {
             state: self.state.clone(),
@@ -827,7 +883,8 @@ impl Model {
     }
 
     /// Advances the state at the communication point to `t_end`: the integrator goes on from
-    /// its front until it reaches `t_end` (a unit with inputs lands every step on it), and the
+    /// its front until it reaches `t_end` (a unit whose inputs changed at the last point lands
+    /// on it, `Engine::sync_inputs`), and the
     /// state at `t_end` is the front where it ends there, else interpolated inside the last step.
     fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
         // within this of t_end, the integrator's state counts as at t_end

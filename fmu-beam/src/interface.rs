@@ -273,6 +273,19 @@ pub fn inputs_ended(sys: &Mechanics, t: f64) -> Vec<f64> {
 }
 
 /// Whether the inputs as set for the next step (value, der1, der2 at its start, 3 per input)
+/// differ in any part from what the last step ended with ([`inputs_ended`]): where none does,
+/// the inputs go on as the unit extrapolated them, and its steps need not land on the
+/// communication point.
+pub fn inputs_changed(ended: &[f64], next: &[f64]) -> bool {
+    ended.len() != next.len() || ended.iter().zip(next).any(|(&a, &b)| differ(a, b))
+}
+
+/// Two input parts differ beyond rounding.
+fn differ(a: f64, b: f64) -> bool {
+    (a - b).abs() > 1e-10 * a.abs().max(b.abs())
+}
+
+/// Whether the inputs as set for the next step (value, der1, der2 at its start, 3 per input)
 /// jump from what the last step ended with ([`inputs_ended`]): a force input whose value
 /// jumps, or a motion input whose value, rate or acceleration jumps. Then the integrator
 /// restarts from consistent accelerations. A force input continuous in value whose derivatives
@@ -284,7 +297,6 @@ pub fn inputs_jump(ended: &[f64], next: &[f64], sys: &Mechanics) -> bool {
         return true;
     }
     let motion = motion_slots(sys);
-    let differ = |a: f64, b: f64| (a - b).abs() > 1e-10 * a.abs().max(b.abs());
     (0..next.len() / 3).any(|k| {
         let parts = if motion[k] { 3 } else { 1 };
         (0..parts).any(|p| differ(ended[3 * k + p], next[3 * k + p]))
@@ -381,7 +393,12 @@ pub fn explain(scene: &Scene, table: &VariableTable) -> String {
         "\nsolver.next_event_time is the next time where a drive or load law jumps (the unit \
          lands there and restarts its integrator); a master joining units mechanically lands \
          there too. An input whose value jumps between steps restarts the integrator; one that \
-         only changes its derivatives (a ramp that continues the last one) does not.\n",
+         only changes its derivatives (a ramp that continues the last one) does not. While the \
+         inputs go on as the last step extrapolated them (held, or left alone), the unit steps \
+         past communication points and interpolates its outputs there, so that its run does not \
+         depend on how the master cuts time; after a point where the master changed them, its \
+         steps land on the next one, and an input changed while the unit is past the point has \
+         its last step redone to land there.\n",
     );
     t
 }

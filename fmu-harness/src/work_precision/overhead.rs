@@ -1,9 +1,10 @@
 //! The unit's own cost per communication step (issue 12: at most 2 µs beyond the steps): the
 //! same internal steps driven by few long and by many short doSteps, the difference in CPU time
 //! over the difference in doSteps. A unit without inputs (C1, fixed step 1e-3 s) steps across
-//! communication points and interpolates its outputs; a unit with inputs (the flexible arm
-//! under a held torque, fixed step 1e-4 s) lands every step on one; in both the internal steps
-//! do not change with the communication step, so what differs is the doSteps' own work.
+//! communication points and interpolates its outputs; so does a unit with inputs while they are
+//! held (the flexible arm under a held torque, fixed step 1e-4 s, whose steps end on the
+//! communication points); in both the internal steps do not change with the communication
+//! step, so what differs is the doSteps' own work.
 
 use super::thread_cpu_seconds;
 use crate::error::HarnessError;
