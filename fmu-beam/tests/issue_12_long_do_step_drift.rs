@@ -245,6 +245,22 @@ fn a_unit_with_inputs_lands_on_each_communication_point_with_the_same_result() {
     assert_eq!(counter(&mut f, "solver.split_steps"), 0);
 }
 
+/// The flexible arm (error control, its shipped settings) from rest over 1 s in doSteps of
+/// `hc`, its input torque set to `torque(t)` before each, 2 N m from the start.
+fn arm_under_torque(hc: f64, torque: impl Fn(f64) -> f64) -> Engine {
+    let mut e = Engine::new(scene("flexible_arm.toml"));
+    let input = vr(&e, "hub.drive.torque");
+    e.set_real(input, 2.0).unwrap();
+    e.exit_initialization().unwrap();
+    let n = (1.0 / hc).round() as usize;
+    for k in 0..n {
+        let t = k as f64 * hc;
+        e.set_real(input, torque(t)).unwrap();
+        e.do_step(t, hc).unwrap();
+    }
+    e
+}
+
 /// An error-controlled unit with an input the master holds (or leaves alone) steps past the
 /// communication points, as a unit without inputs does, so that how the master cuts time does
 /// not move its run: the same steps at one 1 s doStep, 10 ms and 1 ms doSteps, and the same
@@ -255,16 +271,8 @@ fn a_unit_with_inputs_lands_on_each_communication_point_with_the_same_result() {
 fn an_error_controlled_unit_with_a_held_input_does_not_depend_on_the_cut() {
     let outs = ["beam.tip.deflection", "hub.angle"];
     let run = |hc: f64| {
-        let mut e = Engine::new(scene("flexible_arm.toml"));
-        let torque = vr(&e, "hub.drive.torque");
-        e.set_real(torque, 2.0).unwrap();
-        e.exit_initialization().unwrap();
-        let n = (1.0 / hc).round() as usize;
-        for k in 0..n {
-            // the master sets the held value again at every point, as fmpy's loop does
-            e.set_real(torque, 2.0).unwrap();
-            e.do_step(k as f64 * hc, hc).unwrap();
-        }
+        // the master sets the held value again at every point, as fmpy's loop does
+        let mut e = arm_under_torque(hc, |_| 2.0);
         let values: Vec<f64> = outs
             .iter()
             .map(|o| {
@@ -306,18 +314,7 @@ fn an_input_changed_after_the_unit_stepped_past_the_point_is_met_there() {
         (e.get_real(w).unwrap(), e.get_real(a).unwrap())
     };
     let by_input = |hc: f64| {
-        let mut e = Engine::new(scene("flexible_arm.toml"));
-        let torque = vr(&e, "hub.drive.torque");
-        e.set_real(torque, 2.0).unwrap();
-        e.exit_initialization().unwrap();
-        let n = (1.0 / hc).round() as usize;
-        for k in 0..n {
-            let t = k as f64 * hc;
-            if (t - 0.5).abs() < 1e-9 {
-                e.set_real(torque, 0.0).unwrap();
-            }
-            e.do_step(t, hc).unwrap();
-        }
+        let mut e = arm_under_torque(hc, |t| if t < 0.5 - 1e-9 { 2.0 } else { 0.0 });
         outs(&mut e)
     };
     let by_law = {
