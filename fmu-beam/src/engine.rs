@@ -238,8 +238,7 @@ impl Engine {
         let changed = crate::interface::inputs_changed(&m.applied_inputs, &applied);
         m.lands = !applied.is_empty() && changed;
         let jump = crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system);
-        let past = m.front.t > t0 + 1e-6 * m.stepper.settings.max_step;
-        if jump || (changed && past) {
+        if jump || (changed && m.is_past(t0)) {
             // the inputs as the last step ended them (set_real wrote the new ones in already)
             let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
                 m.applied_inputs
@@ -254,10 +253,7 @@ impl Engine {
             } else {
                 m.system.inputs().to_vec()
             };
-            let next = std::mem::replace(m.system.inputs_mut(), ended);
-            let result = m.meet_inputs(t0, h, jump, &next);
-            *m.system.inputs_mut() = next;
-            result?;
+            m.meet_inputs(t0, h, jump, ended)?;
         }
         m.applied_inputs = applied;
         Ok(())
@@ -798,21 +794,53 @@ impl Engine {
 }
 
 impl Model {
-    /// At the communication point t0, with the system's inputs as the last step ended them and
-    /// `next` the ones set for the step to come: lands the integrator on t0 if it stepped past
-    /// it (its last step redone from the state before it), and where the inputs jump, restarts
-    /// the scheme from the consistent accelerations there and meets the jump to `next`. The
-    /// front is replaced only when all of it succeeded.
+    /// Whether the integrator stepped past the communication point t0 (beyond rounding).
+    fn is_past(&self, t0: f64) -> bool {
+        self.front.t > t0 + 1e-6 * self.stepper.settings.max_step
+    }
+
+    /// At the communication point t0, with the system's inputs set for the step to come and
+    /// `ended` the ones the last step ended with: lands the integrator on t0 if it stepped past
+    /// it (its last step redone from the state before it, with the inputs it had), and where the
+    /// inputs jump, restarts the scheme there from the consistent accelerations with `ended` and
+    /// meets the jump. The front is replaced only when all of it succeeded.
     fn meet_inputs(
         &mut self,
         t0: f64,
         h: f64,
         jump: bool,
-        next: &[InputValue],
+        ended: Vec<InputValue>,
     ) -> Result<(), EngineError> {
-        let set = self.stepper.settings;
-        let snap = 1e-6 * set.max_step;
-        let mut st = if self.front.t > t0 + snap {
+        let next = std::mem::replace(self.system.inputs_mut(), ended);
+        let landed = self.land_with_ended_inputs(t0, jump);
+        *self.system.inputs_mut() = next;
+        let (mut st, before) = landed?;
+        if let Some(before) = before {
+            let set = self.stepper.settings;
+            let step = if set.adaptive {
+                st.h.min(set.max_step)
+            } else {
+                set.max_step
+            };
+            self.stepper
+                .meet_jump_from(&self.system, &mut st, &before, step.min(h))?;
+        }
+        self.front = st;
+        self.back = None;
+        self.state.clone_from(&self.front);
+        self.state.t = t0;
+        Ok(())
+    }
+
+    /// The integrator's state on t0 with the system's inputs as the last step ended them (its
+    /// last step redone from `back` where it is past t0), and where the inputs jump, with the
+    /// consistent accelerations there and the equations' values before the jump.
+    fn land_with_ended_inputs(
+        &mut self,
+        t0: f64,
+        jump: bool,
+    ) -> Result<(GaState, Option<integrator::initial::Equated>), EngineError> {
+        let mut st = if self.is_past(t0) {
             let Some(back) = self.back.as_ref().filter(|b| b.t <= t0) else {
                 return Err(EngineError::BadState {
                     message: format!(
@@ -829,37 +857,23 @@ impl Model {
         } else {
             self.front.clone()
         };
-        if jump {
-            // just after t, as the jump is met (a drive law's jump at t is behind the state)
-            let after = st.t * (1.0 + 1e-13) + 1e-13;
-            let (qdd, lambda) = integrator::initial::consistent_accelerations(
-                &self.system,
-                &st.q,
-                &st.v,
-                after,
-                integrator::Scaling::MASS,
-            )?;
-            st.acc = qdd.clone();
-            st.qdd = qdd;
-            st.lambda = lambda;
-            let before = integrator::initial::Equated::at(&self.system, &st, after);
-            let ended = std::mem::replace(self.system.inputs_mut(), next.to_vec());
-            let step = if set.adaptive {
-                st.h.min(set.max_step)
-            } else {
-                set.max_step
-            };
-            let met = self
-                .stepper
-                .meet_jump_from(&self.system, &mut st, &before, step.min(h));
-            *self.system.inputs_mut() = ended;
-            met?;
+        if !jump {
+            return Ok((st, None));
         }
-        self.front = st;
-        self.back = None;
-        self.state.clone_from(&self.front);
-        self.state.t = t0;
-        Ok(())
+        // just after t, as the jump is met (a drive law's jump at t is behind the state)
+        let after = st.t * (1.0 + 1e-13) + 1e-13;
+        let (qdd, lambda) = integrator::initial::consistent_accelerations(
+            &self.system,
+            &st.q,
+            &st.v,
+            after,
+            integrator::Scaling::MASS,
+        )?;
+        st.acc = qdd.clone();
+        st.qdd = qdd;
+        st.lambda = lambda;
+        let before = integrator::initial::Equated::at(&self.system, &st, after);
+        Ok((st, Some(before)))
     }
 
     fn save(&self) -> ModelState {
