@@ -92,6 +92,9 @@ const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 /// Relative stretch of a beam's chord (root to tip) beyond which the step is refused.
 const STRETCH_LIMIT: f64 = 0.01;
 const STATE_VERSION: u32 = 5;
+/// Within this fraction of `max_step` of a communication point, the integrator's state counts
+/// as on it (not past it).
+const SNAP: f64 = 1e-6;
 
 impl Engine {
     pub fn new(scene: Scene) -> Engine {
@@ -237,7 +240,8 @@ impl Engine {
         let applied = flat_inputs(&m.system);
         let changed = crate::interface::inputs_changed(&m.applied_inputs, &applied);
         m.lands = !applied.is_empty() && changed;
-        let jump = crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system);
+        // a jump is a change of some parts
+        let jump = changed && crate::interface::inputs_jump(&m.applied_inputs, &applied, &m.system);
         if jump || (changed && m.is_past(t0)) {
             // the inputs as the last step ended them (set_real wrote the new ones in already)
             let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
@@ -796,7 +800,7 @@ impl Engine {
 impl Model {
     /// Whether the integrator stepped past the communication point t0 (beyond rounding).
     fn is_past(&self, t0: f64) -> bool {
-        self.front.t > t0 + 1e-6 * self.stepper.settings.max_step
+        self.front.t > t0 + SNAP * self.stepper.settings.max_step
     }
 
     /// At the communication point t0, with the system's inputs set for the step to come and
@@ -816,14 +820,9 @@ impl Model {
         *self.system.inputs_mut() = next;
         let (mut st, before) = landed?;
         if let Some(before) = before {
-            let set = self.stepper.settings;
-            let step = if set.adaptive {
-                st.h.min(set.max_step)
-            } else {
-                set.max_step
-            };
+            let step = self.stepper.next_step(&st).min(h);
             self.stepper
-                .meet_jump_from(&self.system, &mut st, &before, step.min(h))?;
+                .meet_jump_from(&self.system, &mut st, &before, step)?;
         }
         self.front = st;
         self.back = None;
@@ -898,11 +897,11 @@ impl Model {
 
     /// Advances the state at the communication point to `t_end`: the integrator goes on from
     /// its front until it reaches `t_end` (a unit whose inputs changed at the last point lands
-    /// on it, `Engine::sync_inputs`), and the
-    /// state at `t_end` is the front where it ends there, else interpolated inside the last step.
+    /// on it, `Engine::sync_inputs`), and the state at `t_end` is the front where it ends
+    /// there, else interpolated inside the last step.
     fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
         // within this of t_end, the integrator's state counts as at t_end
-        let snap = 1e-6 * self.stepper.settings.max_step.min(t_end - self.state.t);
+        let snap = SNAP * self.stepper.settings.max_step.min(t_end - self.state.t);
         if self.front.t < t_end - snap {
             self.back = self.stepper.advance(
                 &self.system,

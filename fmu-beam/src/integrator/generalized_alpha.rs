@@ -584,11 +584,7 @@ impl Stepper {
     ) -> Result<Option<GaState>, EngineError> {
         let set = self.settings;
         let h_min = 1e-12 * t_end.abs().max(1.0);
-        let mut h_try = if set.adaptive {
-            st.h.min(set.max_step)
-        } else {
-            set.max_step
-        };
+        let mut h_try = self.next_step(st);
         // a fixed step whose Newton iteration failed is covered in smaller steps up to here
         let mut divided_until: Option<f64> = None;
         let breakpoints = sys.breakpoints();
@@ -781,6 +777,16 @@ impl Stepper {
             self.meet_jump(sys, st, set.max_step)?;
         }
         Ok(back.filter(|_| st.t > t_end))
+    }
+
+    /// The size of the next step from `st`: the controller's proposal (at most `max_step`)
+    /// under error control, else the fixed step.
+    pub fn next_step(&self, st: &GaState) -> f64 {
+        if self.settings.adaptive {
+            st.h.min(self.settings.max_step)
+        } else {
+            self.settings.max_step
+        }
     }
 
     /// Takes `st` to `t`, a sliver ahead, by an explicit Taylor step, and lands there.
