@@ -14,9 +14,11 @@ const OUTS: [&str; 6] = [
 
 /// No damping but the integrator's: the work of the drive torque equals kinetic + strain
 /// energy (no gravity), less what the integrator takes from the modes its steps do not resolve
-/// (both scenes at rho_inf = 0.7, issue 12: measured up to 1.2e-4 of the work on the elastic
-/// crank, whose modes the torque's cut-off strikes) and never more; the rigid-crank variant
-/// ends within 1 % of the elastic one.
+/// (both scenes at rho_inf = 0.7) and never more. On the elastic crank, whose modes the
+/// torque's cut-off strikes, error control lets ρ∞ damp those its steps do not resolve, as
+/// fixed steps do (issue 12, item 5): measured 2.8e-4 of the work at the shipped tolerance
+/// (1.3e-4 while it resolved them, in 4.7 × the steps); fixed steps of 4e-3 and 1e-3 s take
+/// 3.8e-4 and 2.9e-4. The rigid-crank variant ends within 1 % of the elastic one.
 #[test]
 fn c3_work_balance_and_rigid_crank_agreement() {
     let elastic = run(scene("slider_crank.toml"), &[], &OUTS, 1e-2, 1.6);
@@ -37,7 +39,7 @@ fn c3_work_balance_and_rigid_crank_agreement() {
             high / w
         );
         assert!(low > -1e-6 * w, "no energy created");
-        assert!(high < 2.5e-4 * w, "little taken");
+        assert!(high < 5e-4 * w, "little taken");
     }
     let (se, sr) = (elastic.last(1), rigid.last(1));
     println!("slider at 1.6 s: elastic {se:.6} m, rigid crank {sr:.6} m");

@@ -322,9 +322,13 @@ fn c6_exact_rigid(hc: f64) -> Vec<(f64, f64)> {
 /// controller that rounds its factors moved the 1e-9 run by 8e-8 rad, and runs at 1e-9 to 1e-12
 /// under three controllers spread over 1.2e-7 rad. The mean lag of two elements, measured:
 /// 4.45e-8 s at tolerance 1e-9, 4.86e-8 at 1e-10, 4.93e-8 at 1e-11 (the same to 1e-10 s under
-/// each controller), so at 1e-10 it is converged in time to about 2 %. The exact pendulum's
-/// J = m L²/3 is the rigid twin's inertia about the hinge, checked here from the beam's
-/// undeformed inertia. About 20 s in release.
+/// each controller), so at 1e-10 it is converged in time to about 2 %, which the test checks
+/// against 3e-11. Not against 1e-9 any more: since the error estimate is filtered by the
+/// scheme's damping (issue 12, item 5), the 1e-9 run no longer resolves the in-plane bending
+/// mode the release rings (5.8 kHz, ωh = 7 at 2e-4 s) and takes one step per 2e-4 s sample
+/// (5 000 steps instead of 72 000), where the swing's own error per step is about the
+/// tolerance: its lag is 3.5e-7 s. The exact pendulum's J = m L²/3 is the rigid twin's inertia
+/// about the hinge, checked here from the beam's undeformed inertia. About 25 s in release.
 #[test]
 fn c6_flexible_pendulum_lags_its_rigid_twin() {
     let hc = 2e-4;
@@ -359,9 +363,9 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
         lag
     };
     let lags: Vec<f64> = [1, 2, 4].iter().map(|&n| lag(n, 1e-10)).collect();
-    let looser = lag(2, 1e-9);
-    let moved = (looser - lags[1]).abs();
-    println!("C6 2 elements, tolerance 1e-9 to 1e-10: the lag moves by {moved:.1e} s");
+    let tighter = lag(2, 3e-11);
+    let moved = (tighter - lags[1]).abs();
+    println!("C6 2 elements, tolerance 1e-10 to 3e-11: the lag moves by {moved:.1e} s");
     assert!(
         moved < 0.15 * lags[1],
         "the flexible runs are converged in time: {moved:e} s"

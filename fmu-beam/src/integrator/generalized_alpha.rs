@@ -121,6 +121,13 @@ pub fn jump_scaling(rho_inf: f64, h: f64) -> Scaling {
     }
 }
 
+/// Passes of the scheme's filter over a position error that refuses a step
+/// ([`Stepper::filtered`]). Measured on C3's elastic crank (`fmu-harness peer`, one timed run
+/// each, issue 12 item 5: error-controlled runs against the best fixed step, median): none 2.6,
+/// one pass 2.2 (tolerance 1e-5 still took 429 steps), two 0.7–0.8, three 0.9; with two, C2,
+/// C3's rigid crank and C4 read within the timing's noise of none (docs/accuracy.md).
+const FILTER_PASSES: usize = 2;
+
 const MAX_NEWTON: usize = 16;
 /// Refactorizations of the iteration matrix at the current iterate within one step.
 const MAX_REFRESH: usize = 2;
@@ -825,28 +832,85 @@ impl Stepper {
     /// middle of their range ([`Turning`]): a matrix of a spinning or swinging system stays a
     /// good one over many steps, and no body's mismatch exceeds what it was unturned.
     fn solve_turned(&mut self, q: &DVector<f64>) -> bool {
-        let turned = match (&self.turning, &self.memory.point) {
-            (Some(turning), Some(p)) => {
-                let (lo, hi) = turning
-                    .angles
-                    .iter()
-                    .map(|&k| q[k] - p.q[k])
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
-                        (lo.min(d), hi.max(d))
-                    });
-                // no bodies: ∞ - ∞, not finite
-                let delta = 0.5 * (lo + hi);
-                (delta != 0.0 && delta.is_finite()).then_some((turning, delta))
-            }
-            _ => None,
-        };
-        let Some((turning, delta)) = turned else {
+        let (Some(delta), Some(turning)) = (self.turned(q), &self.turning) else {
             return self.matrix.solve_mut(&mut self.rhs);
         };
         turn_pairs(&mut self.rhs, &turning.pairs, -delta);
         let solved = self.matrix.solve_mut(&mut self.rhs);
         turn_pairs(&mut self.rhs, &turning.pairs, delta);
         solved
+    }
+
+    /// The angle δ by which the matrix is used as turned at iterate `q` (the middle of the
+    /// range of the bodies' turns since it was factorized), where it is not zero.
+    fn turned(&self, q: &DVector<f64>) -> Option<f64> {
+        let (Some(turning), Some(p)) = (&self.turning, &self.memory.point) else {
+            return None;
+        };
+        let (lo, hi) = turning
+            .angles
+            .iter()
+            .map(|&k| q[k] - p.q[k])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
+                (lo.min(d), hi.max(d))
+            });
+        // no bodies: ∞ - ∞, not finite
+        let delta = 0.5 * (lo + hi);
+        (delta != 0.0 && delta.is_finite()).then_some(delta)
+    }
+
+    /// The norm of the step's local error: that of the positions' estimate
+    /// ([`Stepper::position_error`]), and where it refuses the step under ρ∞ < 1, that of the
+    /// estimate filtered by the scheme's damping ([`Stepper::filtered`]) if smaller.
+    fn error_norm(&mut self, st: &GaState, t1: f64, q1: &DVector<f64>, c: &Coefficients) -> f64 {
+        let e = self.position_error(st, t1, q1, c);
+        let raw = self.norm(e.iter(), q1);
+        if raw <= 1.0 || self.settings.rho_inf >= 1.0 {
+            return raw;
+        }
+        self.filtered(e, q1)
+            .map_or(raw, |f| raw.min(self.norm(f.iter(), q1)))
+    }
+
+    /// The position error `e` of a step ending at `q1`, filtered [`FILTER_PASSES`] times by
+    /// the step's iteration matrix ([`IterationMatrix::filter`], turned as the Newton
+    /// corrections are). With S = c_m M + d K_t + c_c C_t (d = βh², c_m = (1 − α_m)/(1 − α_f))
+    /// each pass keeps the motion the step resolves (ωh ≪ 1) and multiplies a mode of
+    /// frequency ω by 1/(1 + β'(ωh)²), β' = β(1 − α_f)/(1 − α_m) (0.27 at ρ∞ = 0.7): the
+    /// modes generalized-α with ρ∞ < 1 damps instead of following. Their raw estimate stays
+    /// up to 8|β − 1/6| × their amplitude however long the step (the third difference of an
+    /// oscillation), so a step that lets ρ∞ damp a mode its jump struck, as a fixed step
+    /// does, was refused for it while the mode lasted, and steps shrank until they resolved
+    /// it: C3's elastic crank at tolerance 1e-5 took 1 368 steps, 1 200 of them after the
+    /// torque's cut-off, to end 4.1e-4 off where the fixed 4e-3 s step (400) ends 1.9e-4 off.
+    /// Filtered twice, such a mode's estimate falls as (ωh)⁻⁴: 183 steps, 6.9e-4 (issue 12,
+    /// item 5; docs/accuracy.md). None when the matrix cannot solve.
+    fn filtered(&mut self, mut e: DVector<f64>, q1: &DVector<f64>) -> Option<DVector<f64>> {
+        let n = e.len();
+        // the bodies' (x, y) pairs among the n coordinates, without the joint rows'
+        let turn = match (self.turned(q1), &self.turning) {
+            (Some(d), Some(t)) => Some((
+                t.pairs
+                    .iter()
+                    .copied()
+                    .filter(|&i| i + 1 < n)
+                    .collect::<Vec<_>>(),
+                d,
+            )),
+            _ => None,
+        };
+        if let Some((pairs, d)) = &turn {
+            turn_pairs(&mut e, pairs, -d);
+        }
+        for _ in 0..FILTER_PASSES {
+            if !self.matrix.filter(&mut e, &mut self.rhs) {
+                return None;
+            }
+        }
+        if let Some((pairs, d)) = &turn {
+            turn_pairs(&mut e, pairs, *d);
+        }
+        Some(e)
     }
 
     /// Whether the iteration matrix is factorized sparse.
@@ -988,8 +1052,7 @@ impl Stepper {
                         qdd[k] = 0.0;
                     }
                     let err = if self.settings.adaptive {
-                        let e = self.position_error(st, t_new, &q, &c);
-                        self.norm(e.iter(), &q)
+                        self.error_norm(st, t_new, &q, &c)
                     } else {
                         0.0
                     };

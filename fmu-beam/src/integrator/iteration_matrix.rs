@@ -72,6 +72,8 @@ pub struct IterationMatrix {
     rows: JacobianRows,
     factors: Factors,
     factored: bool,
+    /// The mass matrix's coefficient in the factorized matrix.
+    cm: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -114,6 +116,7 @@ impl IterationMatrix {
             rows,
             factors,
             factored: false,
+            cm: 1.0,
         }
     }
 
@@ -170,6 +173,7 @@ impl IterationMatrix {
             }
         };
         let n = self.n;
+        self.cm = w.cm;
         self.factored = match &mut self.factors {
             Factors::Dense { jac, lu } => {
                 jac.fill(0.0);
@@ -212,6 +216,28 @@ impl IterationMatrix {
             }
         };
         self.factored
+    }
+
+    /// One pass of the scheme's filter on a position error `e` (n entries), in place: the
+    /// solution x of [[S, Gᵀ], [G, 0]] [x; μ] = [c_m M e; G e], with the matrix's M and G at its
+    /// point and `rhs` (n + m entries) as the workspace. A mode of frequency ω passes with the
+    /// factor c_m / (c_m + d ω²); the part of `e` across the constraints (what a driven joint
+    /// imposes) is kept. False when there are no factors or the solution is not finite.
+    pub fn filter(&mut self, e: &mut DVector<f64>, rhs: &mut DVector<f64>) -> bool {
+        let n = self.n;
+        rhs.fill(0.0);
+        for (r, b) in self.mass.ranges.iter().zip(&self.mass.blocks) {
+            rhs.rows_mut(r.start, r.len())
+                .gemv(self.cm, b, &e.rows(r.start, r.len()), 0.0);
+        }
+        let g = self.rows.values();
+        self.rows
+            .for_each_entry(|row, col, k| rhs[n + row] += g[k] * e[col]);
+        if !self.solve_mut(rhs) || !rhs.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        e.copy_from(&rhs.rows(0, n));
+        true
     }
 
     /// Solves in place with the factors; false when there are none or a finite right-hand

@@ -120,8 +120,10 @@ pub struct SolverSpec {
     /// Relative tolerance of the error control and of the Newton iteration, on each coordinate
     /// against tol × (|q| + the system's length; 1 rad for angles). The local error is estimated
     /// from the positions, so a vibration whose amplitude is below it is left to `rho_inf`'s
-    /// damping rather than resolved. At a fixed step it bounds only Newton's error: set it below
-    /// the accuracy asked of the outputs.
+    /// damping rather than resolved; with `rho_inf` < 1, so is a mode the step does not resolve
+    /// (ω h well above 1): an estimate that refuses a step is filtered by the scheme's damping.
+    /// At a fixed step it bounds only Newton's error: set it below the accuracy asked of the
+    /// outputs.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
