@@ -886,29 +886,17 @@ impl Stepper {
     /// Filtered twice, such a mode's estimate falls as (ωh)⁻⁴: 183 steps, 6.9e-4 (issue 12,
     /// item 5; docs/accuracy.md). None when the matrix cannot solve.
     fn filtered(&mut self, mut e: DVector<f64>, q1: &DVector<f64>) -> Option<DVector<f64>> {
-        let n = e.len();
-        // the bodies' (x, y) pairs among the n coordinates, without the joint rows'
-        let turn = match (self.turned(q1), &self.turning) {
-            (Some(d), Some(t)) => Some((
-                t.pairs
-                    .iter()
-                    .copied()
-                    .filter(|&i| i + 1 < n)
-                    .collect::<Vec<_>>(),
-                d,
-            )),
-            _ => None,
-        };
-        if let Some((pairs, d)) = &turn {
-            turn_pairs(&mut e, pairs, -d);
+        let delta = self.turned(q1);
+        if let (Some(d), Some(t)) = (delta, &self.turning) {
+            turn_pairs(&mut e, &t.pairs, -d);
         }
         for _ in 0..FILTER_PASSES {
             if !self.matrix.filter(&mut e, &mut self.rhs) {
                 return None;
             }
         }
-        if let Some((pairs, d)) = &turn {
-            turn_pairs(&mut e, pairs, *d);
+        if let (Some(d), Some(t)) = (delta, &self.turning) {
+            turn_pairs(&mut e, &t.pairs, d);
         }
         Some(e)
     }
@@ -1133,7 +1121,9 @@ fn third_difference_with_acceleration(t: [f64; 2], q: [f64; 2], v0: f64, a0: f64
 /// Turns each (x, y) pair of `x` starting at the given indices by the angle δ.
 fn turn_pairs(x: &mut DVector<f64>, pairs: &[usize], delta: f64) {
     let (s, c) = delta.sin_cos();
-    for &i in pairs {
+    // pairs past the end of x (the joint rows, where x holds the coordinates alone) are not in it
+    let len = x.len();
+    for &i in pairs.iter().filter(|&&i| i + 1 < len) {
         let (a, b) = (x[i], x[i + 1]);
         x[i] = c * a - s * b;
         x[i + 1] = s * a + c * b;
