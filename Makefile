@@ -15,6 +15,7 @@ PY      := $(VENV)/bin/python
 STAMP   := $(VENV)/.requirements.stamp
 
 HARNESS := target/release/fmu-harness
+BENCH   := target/release/fmu-bench
 ENGINE  := target/release/libfmu_beam.so
 SCENES  := $(wildcard scenes/*.toml)
 
@@ -133,20 +134,20 @@ check:
 	cargo clippy --workspace --all-targets -- -D warnings
 	$(MAKE) test
 
-# Work-precision study (fmu-harness work-precision): every case C1-C4 over formulations, integrator
+# Work-precision study (fmu-bench work-precision, bench/): every case C1-C4 over formulations, integrator
 # settings and effects, then the 3D section (C5, C6, the fast variants; `--cases 3D` runs it alone);
 # build/bench/REPORT.md, points.csv, <case>.png, and the README's chart. Then dense against sparse
-# LU of the iteration matrix by number of substructures (fmu-harness linear-solvers):
+# LU of the iteration matrix by number of substructures (fmu-bench linear-solvers):
 # build/bench/LINEAR.md and linear_solvers.csv (the table of docs/linear_algebra.md).
 # (tests/bench_c1.py, C1 timed through fmpy, runs by hand: $(PY) tests/bench_c1.py)
 bench: .venv release
-	$(HARNESS) work-precision --scenes scenes --output build/bench
-	$(HARNESS) linear-solvers --scenes scenes --output build/bench
+	$(BENCH) work-precision --scenes scenes --output build/bench
+	$(BENCH) linear-solvers --scenes scenes --output build/bench
 	$(PY) tests/plot_work_precision.py build/bench/points.csv --readme C3 docs/work_precision.png
 
 # Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
 # and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
-# steps or tolerances (fmu-harness peer, about 8 min), both scored against the exact references
+# steps or tolerances (fmu-bench peer, about 8 min), both scored against the exact references
 # of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy.
 VENV_BENCH  := .venv-bench
 BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp
@@ -158,7 +159,7 @@ $(BENCH_STAMP): requirements-bench.txt
 bench-peer: $(BENCH_STAMP) release
 	mkdir -p build/bench
 	$(VENV_BENCH)/bin/python bench/peer/sweep.py
-	$(HARNESS) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
+	$(BENCH) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).

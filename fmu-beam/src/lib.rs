@@ -1,25 +1,20 @@
 //! fmu-beam: a flexible-multibody core (floating-frame Euler–Bernoulli beams, joints,
 //! generalized-α) and its FMI 2.0 co-simulation ABI.
 //!
-//! Data flow: [`scene::Scene`] (TOML) → [`multibody::System`] → [`integrator::Stepper`] →
-//! [`engine::Engine`] (one FMU instance, safe) → `fmi2` (the C ABI, the only unsafe code).
+//! Five layers, each importing only from those below it (`tests/layers.rs` checks it):
+//! 1. [`scene`]: the file format (parsing, validation, the rule table); [`error`] beside it;
+//! 2. [`mechanics`]: beam sections and elements, planar and spatial systems, joints, equations;
+//! 3. [`integrator`]: generalized-α, Newton, the iteration matrix, the state codec;
+//! 4. [`unit`]: one FMU instance, safe ([`Engine`]), its variables, interface, effects policy;
+//! 5. `fmi2`: the C ABI, the only unsafe code.
 
-pub mod axial_load;
-pub mod beam;
-pub mod effects;
-pub mod engine;
 pub mod error;
 pub mod fmi2;
 pub mod integrator;
-pub mod interface;
 pub mod mechanics;
-pub mod modes;
-pub mod multibody;
-pub mod multibody3d;
 pub mod scene;
-pub mod shape;
-pub mod variables;
+pub mod unit;
 
-pub use engine::Engine;
 pub use error::EngineError;
 pub use scene::Scene;
+pub use unit::engine::Engine;

@@ -2,9 +2,9 @@
 //! integration of ∫ρ LᵀL (eq. (11)), the quadratic-velocity vector against Lagrange's
 //! equations, the tangents against finite differences, and zero force at rest.
 
-use fmu_beam::beam::planar_beam::{rot, BeamOptions, PlanarBeam, FLEX, THETA};
-use fmu_beam::beam::planar_element::{shape, GAUSS_4};
-use fmu_beam::beam::section::Section;
+use fmu_beam::mechanics::beam::planar_beam::{rot, BeamOptions, PlanarBeam, FLEX, THETA};
+use fmu_beam::mechanics::beam::planar_element::{shape, GAUSS_4};
+use fmu_beam::mechanics::beam::section::Section;
 use fmu_beam::scene::FrameKind;
 use nalgebra::{DMatrix, DVector, Vector2};
 

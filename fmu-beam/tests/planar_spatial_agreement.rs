@@ -39,15 +39,15 @@
 
 mod common;
 
-use fmu_beam::beam::planar_beam::{BeamOptions, PlanarBeam};
-use fmu_beam::beam::section::Section;
-use fmu_beam::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
-use fmu_beam::beam::spatial_element::{NODE_DOFS, TZ, U, V};
-use fmu_beam::beam::spatial_section::SpatialSection;
 use fmu_beam::integrator::{initial_state, Settings, Stats, Stepper};
-use fmu_beam::multibody::joint::Drive;
-use fmu_beam::multibody::law::TimeLaw;
-use fmu_beam::multibody3d::{Body3, Frame3, JointKind3, RigidBody3, System3};
+use fmu_beam::mechanics::beam::planar_beam::{BeamOptions, PlanarBeam};
+use fmu_beam::mechanics::beam::section::Section;
+use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use fmu_beam::mechanics::beam::spatial_element::{NODE_DOFS, TZ, U, V};
+use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::multibody::joint::Drive;
+use fmu_beam::mechanics::multibody::law::TimeLaw;
+use fmu_beam::mechanics::multibody3d::{Body3, Frame3, JointKind3, RigidBody3, System3};
 use fmu_beam::scene::{BeamSpec, Scene};
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 use std::time::Instant;

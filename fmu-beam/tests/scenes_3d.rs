@@ -5,9 +5,9 @@
 mod common;
 
 use common::{run, scene, vr};
-use fmu_beam::beam::matrix_file::MatrixFile;
-use fmu_beam::beam::spatial_element;
-use fmu_beam::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::beam::spatial_element;
+use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
+use fmu_beam::scene::matrix_file::MatrixFile;
 use fmu_beam::{Engine, Scene};
 use nalgebra::DMatrix;
 use std::path::Path;
@@ -311,7 +311,7 @@ fn the_canonical_text_of_a_3d_scene_round_trips() {
 #[test]
 fn the_3d_pendulum_modes_match_beam_theory() {
     // the elastic modes (the free swing about the hinge is a zero frequency)
-    let f: Vec<f64> = fmu_beam::modes::natural_frequencies(&scene("pendulum_3d.toml"))
+    let f: Vec<f64> = fmu_beam::unit::modes::natural_frequencies(&scene("pendulum_3d.toml"))
         .expect("modes")
         .into_iter()
         .filter(|&x| x > 1.0)
@@ -401,7 +401,7 @@ fn a_3d_cantilever_under_input_loads_deflects_and_twists_as_beam_theory_says() {
 #[test]
 fn effects_of_3d_scenes_say_which_element_runs() {
     let first = |file: &str| {
-        let r = fmu_beam::effects::resolve(&scene(file));
+        let r = fmu_beam::unit::effects::resolve(&scene(file));
         let d = &r.decisions[0];
         (d.effect, d.setting.clone())
     };

@@ -9,14 +9,14 @@
 mod common;
 
 use common::{scene, vr};
-use fmu_beam::effects::resolve;
 use fmu_beam::integrator::iteration_matrix::{prefers_sparse, SPARSE_MIN_SIZE};
 use fmu_beam::integrator::{
     initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
     Stepper,
 };
+use fmu_beam::mechanics::multibody::{Equations, Turning};
 use fmu_beam::mechanics::Mechanics;
-use fmu_beam::multibody::{Equations, Turning};
+use fmu_beam::unit::effects::resolve;
 use fmu_beam::{Engine, Scene};
 use nalgebra::{DMatrix, DVector};
 

@@ -6,14 +6,17 @@
 //! states give the planar beam's terms to 1e-12), the frozen-inertia variant and the beam from
 //! a matrix file (parser refusals, the element's own matrices reproducing the element).
 
-use fmu_beam::beam::matrix_file::{self, MatrixFile, MatrixFileError};
-use fmu_beam::beam::planar_beam::{PlanarBeam, FLEX as PFLEX};
-use fmu_beam::beam::planar_element::GAUSS_4;
-use fmu_beam::beam::spatial_beam::{
+use fmu_beam::mechanics::beam::planar_beam::{PlanarBeam, FLEX as PFLEX};
+use fmu_beam::mechanics::beam::planar_element::GAUSS_4;
+use fmu_beam::mechanics::beam::spatial_beam::{
     skew, InertiaModel, SpatialBeam, SpatialBeamProps, FLEX, OMEGA,
 };
-use fmu_beam::beam::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
-use fmu_beam::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::beam::spatial_element::{
+    self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W,
+};
+use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::multibody3d::build::matrix_file_beam;
+use fmu_beam::scene::matrix_file::{self, MatrixFile, MatrixFileError};
 use fmu_beam::scene::FrameKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector2, Vector3};
 
@@ -820,7 +823,7 @@ fn matrix_file_of_the_element_reproduces_the_element() {
         let path = dir.join("element.txt");
         std::fs::write(&path, element_file_text(&p)).unwrap();
         let file = MatrixFile::load(&path).unwrap();
-        let b = file.beam("f", frame, p.rayleigh_alpha, p.rayleigh_beta);
+        let b = matrix_file_beam(&file, "f", frame, p.rayleigh_alpha, p.rayleigh_beta);
         assert_eq!(b.inertia, InertiaModel::Frozen);
         assert!((b.mass / element.mass - 1.0).abs() < 1e-14);
         let g = Vector3::new(0.1, -9.81, 3.0);

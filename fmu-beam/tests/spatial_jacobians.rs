@@ -5,12 +5,12 @@
 
 mod common;
 
-use fmu_beam::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
-use fmu_beam::beam::spatial_section::SpatialSection;
-use fmu_beam::multibody::joint::Drive;
-use fmu_beam::multibody::law::{Law, TimeLaw};
-use fmu_beam::multibody::Equations;
-use fmu_beam::multibody3d::{JointKind3, Load3, RigidBody3, System3};
+use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::multibody::joint::Drive;
+use fmu_beam::mechanics::multibody::law::{Law, TimeLaw};
+use fmu_beam::mechanics::multibody::Equations;
+use fmu_beam::mechanics::multibody3d::{JointKind3, Load3, RigidBody3, System3};
 use fmu_beam::scene::{DriveKind, FrameKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
@@ -231,7 +231,7 @@ fn load_force_matches_central_differences_of_the_frame_pose() {
 /// differences) leave the round-off of the forward differences below the tolerance.
 #[test]
 fn body_tangents_match_central_differences_of_the_residual() {
-    use fmu_beam::multibody3d::Body3;
+    use fmu_beam::mechanics::multibody3d::Body3;
     let mut rng = Random(0x0bad_cafe_f00d_d00d);
     let sys = system(&mut rng);
     let mut bodies: Vec<Body3> = sys.bodies.clone();

@@ -1,10 +1,8 @@
-//! The command line: `package`, `explain`, `modes`, `schema`, `reference`, `work-precision`,
-//! `linear-solvers`, `simulate`, `cosim` and `animate`.
+//! The command line: `package`, `explain`, `modes`, `schema`, `reference`, `simulate`, `cosim`
+//! and `animate` (the benchmarks are `fmu-bench`'s, in bench/).
 
 use crate::error::HarnessError;
-use crate::{
-    animate, cosim, linear_solvers, modes, package, reference, schema, simulate, work_precision,
-};
+use crate::{animate, cosim, modes, package, reference, schema, simulate};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
@@ -136,74 +134,6 @@ pub enum Command {
         #[arg(long)]
         metadata: Option<PathBuf>,
     },
-    /// Work-precision study of the validation cases C1–C4: every formulation (elements,
-    /// substructures, rigid parts, modal truncation, stiffening) at every integrator setting
-    /// against one reference per case, then each effect switched off in turn; writes
-    /// points.csv and REPORT.md.
-    WorkPrecision {
-        /// Directory of the scene files.
-        #[arg(long, default_value = "scenes")]
-        scenes: PathBuf,
-        /// Output directory.
-        #[arg(short, long, default_value = "build/bench")]
-        output: PathBuf,
-        /// Timed runs per point (median, min and max are reported).
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// CPU seconds of one run above which the tighter settings of the same formulation
-        /// and integrator mode are skipped.
-        #[arg(long, default_value_t = 2.5)]
-        budget: f64,
-        /// Only these cases: C1, C2, C3, C4 (planar), C5, C6, F3 (3D: the roll-up, the
-        /// pendulum, the fast variants), or 3D for all three.
-        #[arg(long, value_delimiter = ',')]
-        cases: Vec<String>,
-    },
-    /// C2–C4 against the exact references of bench/reference and against the peer (Exudyn,
-    /// whose points `bench/peer/sweep.py` writes): the CPU time ratio of the cheapest run of
-    /// each tool that meets 1e-2 … 1e-5; writes ours_points.csv and PEER.md.
-    Peer {
-        /// Directory of the scene files.
-        #[arg(long, default_value = "scenes")]
-        scenes: PathBuf,
-        /// Directory of the reference CSVs.
-        #[arg(long, default_value = "bench/reference")]
-        references: PathBuf,
-        /// The peer's points (without it, or if it does not exist, only ours are written).
-        #[arg(long, default_value = "build/bench/peer_points.csv")]
-        peer_points: PathBuf,
-        /// Output directory.
-        #[arg(short, long, default_value = "build/bench")]
-        output: PathBuf,
-        /// Timed runs per point (median, min and max are reported).
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// CPU seconds of one run above which the tighter settings of the same formulation
-        /// and integrator mode are skipped.
-        #[arg(long, default_value_t = 4.0)]
-        budget: f64,
-        /// Only these cases (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
-        #[arg(long, value_delimiter = ',')]
-        cases: Vec<String>,
-        /// Our points from an earlier run (its ours_points.csv) instead of a new sweep: the
-        /// report again, in seconds.
-        #[arg(long)]
-        ours_points: Option<PathBuf>,
-    },
-    /// Dense against sparse LU of the iteration matrix: C2's pendulum and C4's spin-up with
-    /// k = 5…80 substructures and C1's beam with e elements, at fixed steps; CPU time per step,
-    /// per factorization and per solve; writes LINEAR.md and linear_solvers.csv.
-    LinearSolvers {
-        /// Directory of the scene files.
-        #[arg(long, default_value = "scenes")]
-        scenes: PathBuf,
-        /// Output directory.
-        #[arg(short, long, default_value = "build/bench")]
-        output: PathBuf,
-        /// Timed rounds (median, min and max are reported).
-        #[arg(long, default_value_t = 5)]
-        rounds: usize,
-    },
 }
 
 /// Runs one command, writing its report to `out`.
@@ -231,130 +161,6 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
                 engines.join(", ")
             )
             .map_err(stdout_err)?;
-        }
-        Command::WorkPrecision {
-            scenes,
-            output,
-            repeats,
-            budget,
-            cases,
-        } => {
-            let wanted = |name: &str| {
-                cases.is_empty()
-                    || cases.iter().any(|n| {
-                        n == name || (n == "3D" && work_precision::spatial::NAMES.contains(&name))
-                    })
-            };
-            let chosen: Vec<_> = work_precision::cases::cases()
-                .into_iter()
-                .filter(|c| wanted(c.name))
-                .collect();
-            let spatial: Vec<&str> = work_precision::spatial::NAMES
-                .into_iter()
-                .filter(|n| wanted(n))
-                .collect();
-            let options = work_precision::Options { repeats, budget };
-            let started = std::time::Instant::now();
-            let mut progress = |line: &str| eprintln!("{line}");
-            let results = work_precision::study(&scenes, &chosen, &options, &mut progress)?;
-            let spatial = if spatial.is_empty() {
-                None
-            } else {
-                Some(work_precision::spatial::study(
-                    &scenes,
-                    &spatial,
-                    &options,
-                    &mut progress,
-                )?)
-            };
-            let header = format!(
-                "{}\n\n{}",
-                work_precision::header(&options, started.elapsed().as_secs_f64()),
-                work_precision::overhead::table(&scenes, 5)?
-            );
-            for path in work_precision::report::write(&output, &results, spatial.as_ref(), &header)?
-            {
-                writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
-            }
-        }
-        Command::Peer {
-            scenes,
-            references,
-            peer_points,
-            output,
-            repeats,
-            budget,
-            cases,
-            ours_points,
-        } => {
-            use work_precision::peer;
-            let chosen: Vec<_> = peer::cases()
-                .into_iter()
-                .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
-                .collect();
-            let started = std::time::Instant::now();
-            let mut progress = |line: &str| eprintln!("{line}");
-            let ours = match &ours_points {
-                Some(path) => peer::read_peer(path)?
-                    .into_iter()
-                    .filter(|p| chosen.iter().any(|c| c.name == p.case))
-                    .collect(),
-                None => peer::study(
-                    &scenes,
-                    &references,
-                    &chosen,
-                    repeats,
-                    budget,
-                    &mut progress,
-                )?,
-            };
-            let theirs = if peer_points.is_file() {
-                peer::read_peer(&peer_points)?
-            } else {
-                writeln!(
-                    out,
-                    "{} does not exist (run bench/peer/sweep.py): our points only",
-                    peer_points.display()
-                )
-                .map_err(stdout_err)?;
-                Vec::new()
-            };
-            let header = match &ours_points {
-                Some(path) => format!(
-                    "Our points from {}; the peer's points from {}.",
-                    path.display(),
-                    peer_points.display()
-                ),
-                None => format!(
-                    "{} timed runs per point; our sweep took {:.0} s; the peer's points from {}.",
-                    repeats,
-                    started.elapsed().as_secs_f64(),
-                    peer_points.display()
-                ),
-            };
-            let text = peer::report(&chosen, &ours, &theirs, &header);
-            for path in peer::write(&output, &ours, &text)? {
-                writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
-            }
-            out.write_all(text.as_bytes()).map_err(stdout_err)?;
-        }
-        Command::LinearSolvers {
-            scenes,
-            output,
-            rounds,
-        } => {
-            let started = std::time::Instant::now();
-            let rows =
-                linear_solvers::study(&scenes, rounds, &mut |line: &str| eprintln!("{line}"))?;
-            let header = format!(
-                "Generated by `make bench` (`fmu-harness linear-solvers --rounds {rounds}`) in \
-                 {:.0} s wall time. Reproduce: `cargo run --release -p fmu-harness -- \
-                 linear-solvers --scenes scenes --output build/bench`.\n",
-                started.elapsed().as_secs_f64()
-            );
-            for path in linear_solvers::write(&output, &rows, rounds, &header)? {
-                writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
-            }
         }
         Command::Simulate {
             fmu,
@@ -501,7 +307,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
         }
         Command::Explain { scene } => {
             let scene = fmu_beam::Scene::load(&scene)?;
-            let text = fmu_beam::effects::resolve(&scene).explain(&scene);
+            let text = fmu_beam::unit::effects::resolve(&scene).explain(&scene);
             out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
         Command::Schema { output } => {

@@ -54,7 +54,7 @@ pub enum HarnessError {
     Template { message: String },
     #[error(
         "scene `{scene}`: variable `{variable}` has unit `{unit}`, which \
-         fmu_beam::variables::UNITS does not define: the FMU would not validate"
+         fmu_beam::unit::variables::UNITS does not define: the FMU would not validate"
     )]
     UndefinedUnit {
         scene: String,
@@ -64,7 +64,7 @@ pub enum HarnessError {
     #[error("scene `{scene}`: its canonical text for resources/scene.toml is unusable: {message}")]
     CanonicalScene { scene: String, message: String },
     #[error(transparent)]
-    MatrixFile(#[from] fmu_beam::beam::matrix_file::MatrixFileError),
+    MatrixFile(#[from] fmu_beam::scene::matrix_file::MatrixFileError),
     #[error(transparent)]
     Simulate(#[from] crate::simulate::SimulateError),
     #[error(transparent)]

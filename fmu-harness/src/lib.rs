@@ -2,7 +2,7 @@
 //! linearized natural frequencies, and runs FMI 2.0 co-simulation FMUs (any, not only ours)
 //! through [`slave::Slave`] over the raw binding [`fmi2_binding`] (the crate's only unsafe code).
 //!
-//! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::variables::VariableTable`] →
+//! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::unit::variables::VariableTable`] →
 //! [`model_description::render`] (the template in `modelDescription-templates/`) →
 //! [`guid::guid`] → [`archive::write_fmu`] (deterministic zip, written atomically).
 
@@ -14,7 +14,6 @@ pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi2_binding;
 pub mod guid;
-pub mod linear_solvers;
 pub mod log_categories;
 pub mod model_description;
 pub mod modes;
@@ -25,6 +24,5 @@ pub mod schema;
 pub mod simulate;
 pub mod slave;
 pub mod template;
-pub mod work_precision;
 
 pub use error::HarnessError;

@@ -14,7 +14,7 @@
 
 use crate::fmi2::exports::*;
 use crate::fmi2::types::*;
-use crate::variables::VariableTable;
+use crate::unit::variables::VariableTable;
 use crate::Scene;
 use std::ffi::{CStr, CString};
 use std::os::raw::{c_char, c_int, c_void};
@@ -179,7 +179,7 @@ fn vr(name: &str) -> fmi2ValueReference {
 
 /// Value references of every Real output.
 fn real_outputs() -> Vec<fmi2ValueReference> {
-    use crate::variables::{Causality, VarType};
+    use crate::unit::variables::{Causality, VarType};
     let scene = Scene::from_toml_str(SCENE, "test").unwrap();
     VariableTable::build(&scene)
         .variables

@@ -14,7 +14,7 @@
 use super::guard::Fault;
 use super::state_machine::ModelState;
 use super::types::fmi2FMUstate;
-use crate::engine::{Engine, Snapshot};
+use crate::unit::engine::{Engine, Snapshot};
 
 /// Marks memory that holds a live [`FmuState`] (cleared when it is freed).
 const TAG: u64 = u64::from_le_bytes(*b"fmustate");

@@ -18,8 +18,8 @@ use super::state_machine::ModelState;
 use super::types::{
     self as t, fmi2Boolean, fmi2False, fmi2Status, fmi2StatusKind, fmi2True, fmi2Type,
 };
-use crate::engine::Engine;
 use crate::error::EngineError;
+use crate::unit::engine::Engine;
 
 pub struct Instance {
     pub(super) logger: Logger,
@@ -300,7 +300,7 @@ impl Instance {
     }
 
     /// fmi2GetDirectionalDerivative: dv_unknown = (∂ outputs / ∂ inputs) dv_known, exact, at
-    /// the current communication point ([`crate::interface`]).
+    /// the current communication point ([`crate::unit::interface`]).
     pub fn get_directional_derivative(
         &mut self,
         unknowns: &[u32],

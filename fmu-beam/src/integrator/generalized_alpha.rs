@@ -14,7 +14,7 @@ use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
+use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
 use nalgebra::DVector;
 
 /// The integration state at a step boundary.

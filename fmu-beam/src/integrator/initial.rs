@@ -4,7 +4,7 @@
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::{GaState, Settings};
 use crate::error::EngineError;
-use crate::multibody::Equations;
+use crate::mechanics::multibody::Equations;
 use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector};
 

@@ -1,12 +1,12 @@
 //! The scaled iteration matrix of the Newton iteration,
 //! [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]], assembled from the system's body blocks and
-//! constraint rows ([`crate::multibody::sparsity`]) and factorized either dense (nalgebra's LU
+//! constraint rows ([`crate::mechanics::multibody::sparsity`]) and factorized either dense (nalgebra's LU
 //! with partial pivoting) or sparse (faer's sparse LU: the fill-reducing column ordering and
 //! symbolic analysis once per system, only the numeric factorization at each evaluation).
 //! [`LinearSolver::Auto`] chooses from the system's size by [`prefers_sparse`], a rule read off
 //! the measurements of `fmu-harness linear-solvers` (docs/linear_algebra.md).
 
-use crate::multibody::{BlockDiagonal, Equations, JacobianRows};
+use crate::mechanics::multibody::{BlockDiagonal, Equations, JacobianRows};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,

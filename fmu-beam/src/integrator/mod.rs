@@ -1,5 +1,6 @@
 //! Time integration of M(q) q'' + G(q)ᵀλ = Q(q, q', t), g(q) = 0.
 
+pub mod codec;
 pub mod dense_output;
 pub mod generalized_alpha;
 pub mod initial;
@@ -12,9 +13,9 @@ pub use generalized_alpha::{
 pub use initial::initial_state;
 pub use iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 
-use crate::engine::{write_vec, Reader};
 use crate::error::EngineError;
 use crate::scene::Scene;
+pub(crate) use codec::{write_vec, Reader};
 
 /// Solver settings (all tunable between communication steps).
 #[derive(Debug, Clone, Copy, PartialEq)]

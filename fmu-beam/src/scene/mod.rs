@@ -4,6 +4,7 @@
 //! experiment. Unknown keys are refused by serde (`deny_unknown_fields`); every value rule is
 //! checked in [`validate`], whose errors name the field and the rule.
 
+pub mod matrix_file;
 mod planar;
 pub mod rules;
 mod space;
@@ -289,11 +290,13 @@ pub struct BeamSpec {
     #[serde(default)]
     pub outputs: Vec<String>,
     /// Points of the deformed centre line offered as `<beam>.shape.x[i]`, `.y[i]` (3D: `.z[i]`),
-    /// equally spaced from flange a to flange b; absent: at the nodes; 0: no shape outputs
-    /// (`crate::shape`).
+    /// equally spaced from flange a to flange b; absent: at the nodes; 0: no shape outputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_points: Option<usize>,
 }
+
+/// Most shape points a beam may ask for (`shape_points`).
+pub const MAX_POINTS: usize = 1000;
 
 /// The name in a beam's `outputs` list that offers its shape outputs (the points of its
 /// deformed centre line and the axis its deflections are measured from).

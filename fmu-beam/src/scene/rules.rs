@@ -93,7 +93,29 @@ use Dims::{Any, Planar, Spatial};
 pub const LAWS: [&str; 5] = ["constant", "exponential", "spin_up", "table", "input"];
 /// The section shapes.
 pub const SHAPES: [&str; 4] = ["rectangle", "circle", "hollow_rectangle", "hollow_circle"];
-/// The effects a scene can list (`crate::effects::EFFECTS`, by name).
+/// The effects a list may name, with what each one is.
+pub const EFFECTS: [(&str, &str); 6] = [
+    ("gravity", "the gravity field of world.gravity"),
+    (
+        "flexibility",
+        "deformation of the beams (off: every beam is a rigid bar)",
+    ),
+    (
+        "axial",
+        "axial deformation of the beams (off: inextensible)",
+    ),
+    (
+        "quadratic_velocity",
+        "centrifugal and Coriolis terms of the beams' deformation",
+    ),
+    (
+        "geometric_stiffening",
+        "the geometric stiffness of the beams that ask for it (`geometric_stiffening = true`)",
+    ),
+    ("rayleigh_damping", "Rayleigh damping of the beams"),
+];
+
+/// The effects a scene can list ([`EFFECTS`], by name).
 pub const EFFECT_NAMES: [&str; 6] = [
     "gravity",
     "flexibility",
@@ -872,7 +894,7 @@ mod tests {
 
     #[test]
     fn the_tables_quote_the_engine_constants() {
-        let effects: Vec<&str> = crate::effects::EFFECTS.iter().map(|(n, _)| *n).collect();
+        let effects: Vec<&str> = EFFECTS.iter().map(|(n, _)| *n).collect();
         assert_eq!(effects, EFFECT_NAMES);
         assert!(EFFECT_KNOWN.text.ends_with(&EFFECT_NAMES.join(", ")));
         assert!(MIN_STEP
@@ -888,7 +910,7 @@ mod tests {
             .ends_with(&super::super::BEAM_OUTPUT_NAMES_3D.join(", ")));
         assert!(SHAPE_POINTS
             .text
-            .contains(&format!("2 to {}", crate::shape::MAX_POINTS)));
+            .contains(&format!("2 to {}", super::super::MAX_POINTS)));
         assert!(SPATIAL_EFFECTS
             .text
             .ends_with(&super::super::SPATIAL_EFFECTS.join(", ")));

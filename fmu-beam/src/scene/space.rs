@@ -7,7 +7,7 @@ use super::planar::unit;
 use super::rules::{self as r, Rule};
 use super::validate::{Checker, SceneError};
 use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
-use crate::beam::matrix_file;
+use crate::scene::matrix_file;
 
 /// Effects a scene run with the 3D element can switch (the others are planar-only).
 pub const SPATIAL_EFFECTS: [&str; 3] = ["gravity", "flexibility", "rayleigh_damping"];

@@ -390,7 +390,7 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<()
         }
     }
     if let Some(n) = b.shape_points {
-        if n == 1 || n > crate::shape::MAX_POINTS {
+        if n == 1 || n > super::MAX_POINTS {
             return Err(ck.fail(&r::SHAPE_POINTS, &f("shape_points"), n));
         }
     }

@@ -1,0 +1,142 @@
+//! The equations an engine runs: the planar [`System`] (planar scenes, and 3D scenes whose
+//! motion reduces to the plane, [`Scene::planar_reduction`]) or the spatial [`System3`]. One
+//! [`Equations`] implementation over both, so the integrator and the engine see one type.
+
+use super::Effects;
+use crate::error::EngineError;
+use crate::mechanics::multibody::equations::{CoordinateKind, Equations, Turning};
+use crate::mechanics::multibody::law::InputValue;
+use crate::mechanics::multibody::sparsity::{BlockDiagonal, JacobianRows};
+use crate::mechanics::multibody::System;
+use crate::mechanics::multibody3d::build::{self, SceneIndex};
+use crate::mechanics::multibody3d::System3;
+use crate::scene::Scene;
+use nalgebra::DVector;
+use std::ops::Range;
+
+#[derive(Debug, Clone)]
+pub enum Mechanics {
+    /// The planar system, with the planar scene it was built from.
+    Planar(System, Box<Scene>),
+    Spatial(System3, SceneIndex),
+}
+
+/// Runs `$e` with `$s` bound to whichever system `$m` holds.
+macro_rules! each {
+    ($m:expr, $s:ident => $e:expr) => {
+        match $m {
+            Mechanics::Planar($s, _) => $e,
+            Mechanics::Spatial($s, _) => $e,
+        }
+    };
+}
+
+impl Mechanics {
+    /// The system of a validated scene computing `effects` (resolved from the same scene).
+    pub fn build(scene: &Scene, effects: &Effects) -> Mechanics {
+        match scene.planar_reduction() {
+            Ok(planar) => {
+                let sys = System::build(&planar, effects);
+                Mechanics::Planar(sys, Box::new(planar))
+            }
+            Err(_) => {
+                let (sys, index) = build::from_scene(scene, effects);
+                Mechanics::Spatial(sys, index)
+            }
+        }
+    }
+
+    pub fn inputs(&self) -> &[InputValue] {
+        each!(self, s => &s.inputs)
+    }
+
+    pub fn inputs_mut(&mut self) -> &mut Vec<InputValue> {
+        each!(self, s => &mut s.inputs)
+    }
+}
+
+impl Equations for Mechanics {
+    fn n(&self) -> usize {
+        each!(self, s => Equations::n(s))
+    }
+    fn m(&self) -> usize {
+        each!(self, s => Equations::m(s))
+    }
+    fn length_scale(&self) -> f64 {
+        each!(self, s => Equations::length_scale(s))
+    }
+    fn coordinate_kinds(&self) -> Vec<CoordinateKind> {
+        each!(self, s => Equations::coordinate_kinds(s))
+    }
+    fn frame_coordinates(&self) -> Vec<usize> {
+        each!(self, s => Equations::frame_coordinates(s))
+    }
+    /// The planar system places its bodies from the planar scene it was built from.
+    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+        match self {
+            Mechanics::Planar(s, planar) => Equations::initial_coordinates(s, planar),
+            Mechanics::Spatial(s, _) => Equations::initial_coordinates(s, scene),
+        }
+    }
+    fn body_ranges(&self) -> Vec<Range<usize>> {
+        each!(self, s => Equations::body_ranges(s))
+    }
+    fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        each!(self, s => Equations::row_bodies(s))
+    }
+    fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        each!(self, s => Equations::mass_blocks(s, q, m))
+    }
+    fn body_residual(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        t: f64,
+        r: &mut DVector<f64>,
+    ) {
+        each!(self, s => Equations::body_residual(s, q, v, a, t, r))
+    }
+    fn tangent_blocks(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        lambda: &DVector<f64>,
+        t: f64,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
+    ) {
+        each!(self, s => Equations::tangent_blocks(s, q, v, a, lambda, t, kt, ct))
+    }
+    fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
+        each!(self, s => Equations::constraints(s, q, t, g))
+    }
+    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, gm: &mut JacobianRows) {
+        each!(self, s => Equations::jacobian_rows(s, q, t, gm))
+    }
+    fn constraints_and_rows(
+        &self,
+        q: &DVector<f64>,
+        t: f64,
+        g: &mut DVector<f64>,
+        gm: &mut JacobianRows,
+    ) {
+        each!(self, s => Equations::constraints_and_rows(s, q, t, g, gm))
+    }
+    fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
+        each!(self, s => Equations::accel_bias(s, q, v, t, out))
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        each!(self, s => Equations::breakpoints(s))
+    }
+    fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
+        each!(self, s => Equations::joints_of_rows(s, rows))
+    }
+    fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
+        each!(self, s => Equations::power(s, q, v, lambda, t))
+    }
+    fn turning(&self) -> Option<Turning> {
+        each!(self, s => Equations::turning(s))
+    }
+}

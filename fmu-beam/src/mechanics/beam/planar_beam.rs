@@ -1,0 +1,938 @@
+//! A planar flexible beam in one floating frame (planar paper §3, eq. (1)–(13)).
+//!
+//! Body coordinates z = [R_x, R_y, θ, q_f]: the world position and angle of the reference frame
+//! (at flange a) and the deformation coordinates left after the boundary conditions of §3.3.
+//! Every shape integral of eq. (11) is computed once, here, with 4-point Gauss per element; each
+//! evaluation only combines them with the current q_f. The equations are written in world
+//! components for R (so joints and gravity stay simple), which is eq. (5) rotated by A.
+//!
+//! Residual of the body (generalized inertia + internal - applied forces):
+//! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
+//! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
+
+use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
+use super::section::Section;
+use crate::scene::{BeamSpec, FrameKind};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix2, Vector2};
+use std::cell::Cell;
+
+/// Which terms a beam computes (the resolved effects of its scene, `unit::effects`). A term
+/// that is off is not evaluated at all; the full model has every term on and no truncation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BeamOptions {
+    /// Axial deformation coordinates u kept (off: the beam is inextensible, its u are removed).
+    pub axial: bool,
+    /// Quadratic-velocity (centrifugal and Coriolis) terms h(z, ż).
+    pub quadratic_velocity: bool,
+    /// Rayleigh damping D_ff q̇_f.
+    pub damping: bool,
+    /// Geometric stiffening (nonlinear axial strain); needs `axial`.
+    pub geometric_stiffening: bool,
+    /// Modal truncation: keep the lowest k modes of (K_ff, M_ff) as coordinates.
+    pub modes: Option<usize>,
+}
+
+impl Default for BeamOptions {
+    fn default() -> Self {
+        BeamOptions {
+            axial: true,
+            quadratic_velocity: true,
+            damping: true,
+            geometric_stiffening: false,
+            modes: None,
+        }
+    }
+}
+
+/// How often each optional term was evaluated (residual or tangent), so a test can prove that a
+/// term switched off costs nothing: its count stays zero.
+#[derive(Debug, Clone, Default)]
+pub struct TermCounts {
+    pub gravity: Cell<u64>,
+    pub quadratic_velocity: Cell<u64>,
+    pub damping: Cell<u64>,
+    pub geometric_stiffening: Cell<u64>,
+    pub axial: Cell<u64>,
+}
+
+impl TermCounts {
+    pub fn bump(c: &Cell<u64>) {
+        c.set(c.get() + 1);
+    }
+
+    /// Adds another body's counts into these.
+    pub fn add(&self, other: &TermCounts) {
+        for (a, b) in self.cells().into_iter().zip(other.cells()) {
+            a.set(a.get() + b.get());
+        }
+    }
+
+    fn cells(&self) -> [&Cell<u64>; 5] {
+        [
+            &self.gravity,
+            &self.quadratic_velocity,
+            &self.damping,
+            &self.geometric_stiffening,
+            &self.axial,
+        ]
+    }
+}
+
+/// Index of the angle θ in the body coordinates; q_f starts at [`FLEX`].
+pub const THETA: usize = 2;
+pub const FLEX: usize = 3;
+
+/// Rotation matrix A(θ) and its derivative A_θ.
+pub fn rot(theta: f64) -> (Matrix2<f64>, Matrix2<f64>) {
+    let (s, c) = theta.sin_cos();
+    (Matrix2::new(c, -s, s, c), Matrix2::new(-s, -c, c, -s))
+}
+
+/// A material point of the beam expressed through q_f: ū = s0 + S_p q_f, slope angle S_φ q_f.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointMap {
+    /// Undeformed position in the beam frame (m).
+    pub s0: Vector2<f64>,
+    /// Deformation displacement per q_f (2 × nf).
+    pub sp: DMatrix<f64>,
+    /// Rotation of the section per q_f (1 × nf, stored as a vector).
+    pub sphi: DVector<f64>,
+}
+
+/// Body coordinates (or their rates) as the beam reads them: a whole vector or a view into the
+/// system's q, without a copy.
+pub trait Coords<'a>: Into<DVectorView<'a, f64>> {}
+impl<'a, T: Into<DVectorView<'a, f64>>> Coords<'a> for T {}
+
+impl PointMap {
+    /// S_p q_f, the deformation displacement of the point.
+    pub fn displacement(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        let mut s = Vector2::zeros();
+        for k in 0..self.sp.ncols() {
+            s[0] += self.sp[(0, k)] * f[k];
+            s[1] += self.sp[(1, k)] * f[k];
+        }
+        s
+    }
+}
+
+/// Column k of a 2 × nf matrix.
+fn col2(m: &DMatrix<f64>, k: usize) -> Vector2<f64> {
+    Vector2::new(m[(0, k)], m[(1, k)])
+}
+
+/// The assembled beam: constants of eq. (11) reduced to the kept deformation coordinates.
+#[derive(Debug, Clone)]
+pub struct PlanarBeam {
+    pub name: String,
+    pub length: f64,
+    pub elements: usize,
+    pub frame: FrameKind,
+    pub section: Section,
+    /// Mass per unit length ρA (kg/m), EA (N), EJ (N m^2).
+    pub mu: f64,
+    pub ea: f64,
+    pub ej: f64,
+    pub rayleigh_alpha: f64,
+    pub rayleigh_beta: f64,
+    /// Full nodal indices (3 per node) kept by the boundary conditions of §3.3.
+    pub kept: Vec<usize>,
+    /// Total mass m.
+    pub mass: f64,
+    /// ∫ρ ū0 dV (S̄_t of the undeformed beam).
+    pub st0: Vector2<f64>,
+    /// ∫ρ ū0ᵀū0 dV.
+    pub i0: f64,
+    /// S̄ = ∫ρ S dV (2 × nf).
+    pub sbar: DMatrix<f64>,
+    /// a = ∫ρ Sᵀ ū0 dV.
+    pub a: DVector<f64>,
+    /// b = ∫ρ (ū0₁ S₂ - ū0₂ S₁) dV, the constant part of Ī_θf.
+    pub b: DVector<f64>,
+    /// m_ff = ∫ρ SᵀS dV.
+    pub mff: DMatrix<f64>,
+    /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
+    pub w: DMatrix<f64>,
+    pub kff: DMatrix<f64>,
+    /// D_ff = alpha m_ff + beta K_ff.
+    pub dff: DMatrix<f64>,
+    pub flange_a: PointMap,
+    pub flange_b: PointMap,
+    /// Nonlinear axial strain ε = u' + v'²/2 (geometric stiffening), when on.
+    pub geometric_stiffening: bool,
+    /// The terms this beam computes.
+    pub options: BeamOptions,
+    /// Modal truncation: q_nodal = Φ q_f, Φ the lowest modes (kept × k), mass-normalized.
+    pub basis: Option<DMatrix<f64>>,
+    /// Evaluations of the optional terms.
+    pub counts: TermCounts,
+    /// Per deformation coordinate k, the columns l where m_ff, W (either way), K_ff or D_ff
+    /// have a nonzero entry: the element matrices are assembled into a band, so the products
+    /// of each evaluation skip the zeros (bit for bit the same sums).
+    band: Vec<std::ops::Range<usize>>,
+    /// The element's slope rows at the Gauss points and ⟨v'_q v'_qᵀ⟩, constant per beam.
+    strain: StrainRows,
+}
+
+/// The constant parts of an element's nonlinear strain (all elements of a beam are alike).
+#[derive(Debug, Clone, Default)]
+struct StrainRows {
+    /// dv/dx as a row on the element's coordinates, at each point of `GAUSS_4`.
+    slopes: [[f64; ELEMENT_DOFS]; 4],
+    /// Σ w ds dsᵀ over the points: the Hessian of the element mean of v'²/2.
+    hv: [[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
+}
+
+impl StrainRows {
+    fn new(l: f64) -> StrainRows {
+        let mut r = StrainRows::default();
+        for (g, &(xi, w)) in GAUSS_4.iter().enumerate() {
+            let ds = planar_element::slope(xi, l);
+            for p in 0..ELEMENT_DOFS {
+                r.slopes[g][p] = ds[p];
+                for q in 0..ELEMENT_DOFS {
+                    r.hv[p][q] += w * ds[p] * ds[q];
+                }
+            }
+        }
+        r
+    }
+}
+
+/// Full-beam integrals before the boundary conditions remove coordinates.
+struct FullIntegrals {
+    sbar: DMatrix<f64>,
+    a: DVector<f64>,
+    b: DVector<f64>,
+    mff: DMatrix<f64>,
+    w: DMatrix<f64>,
+    kff: DMatrix<f64>,
+}
+
+impl PlanarBeam {
+    /// Builds the beam from its (validated) scene entry.
+    /// (Every term on, geometric stiffening as the scene entry says, no truncation.)
+    pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
+        let options = BeamOptions {
+            geometric_stiffening: spec.geometric_stiffening,
+            modes: spec.modes,
+            ..BeamOptions::default()
+        };
+        PlanarBeam::part_of(spec, &spec.name, spec.length, options)
+    }
+
+    /// One floating frame of a (validated) scene beam: the whole beam, or one of its
+    /// substructures, named `name`, of length `length`, computing the terms of `options`.
+    pub fn part_of(spec: &BeamSpec, name: &str, length: f64, options: BeamOptions) -> PlanarBeam {
+        PlanarBeam::with_options(
+            name,
+            length,
+            crate::scene::Scene::beam_layout(spec).0,
+            spec.frame,
+            spec.material.rho,
+            spec.material.e,
+            Section::from_spec(&spec.section),
+            spec.rayleigh.alpha,
+            spec.rayleigh.beta,
+            options,
+        )
+    }
+
+    /// The full model (every term on, no truncation).
+    pub fn new(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FrameKind,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+    ) -> PlanarBeam {
+        PlanarBeam::with_options(
+            name,
+            length,
+            elements,
+            frame,
+            rho,
+            e,
+            section,
+            rayleigh_alpha,
+            rayleigh_beta,
+            BeamOptions::default(),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_options(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FrameKind,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+        options: BeamOptions,
+    ) -> PlanarBeam {
+        let n_full = 3 * (elements + 1);
+        let kept: Vec<usize> = (0..n_full)
+            .filter(|&i| match frame {
+                FrameKind::Tangent => i >= 3,
+                FrameKind::Pinned => i >= 2 && i != 3 * elements + 1,
+            })
+            .filter(|&i| options.axial || i % 3 != 0)
+            .collect();
+        let mu = rho * section.area;
+        let ea = e * section.area;
+        let ej = e * section.second_moment;
+        let full = full_integrals(length, elements, mu, ea, ej);
+        let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
+        let pick = |m: &DMatrix<f64>| m.select_rows(kept.iter()).select_columns(kept.iter());
+        let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
+        let mff = pick(&full.mff);
+        let kff = pick(&full.kff);
+        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
+        let mass = mu * length;
+        let node_map = |node: usize, x: f64| {
+            let mut sp_full = DMatrix::zeros(2, n_full);
+            sp_full[(0, 3 * node)] = 1.0;
+            sp_full[(1, 3 * node + 1)] = 1.0;
+            let mut sphi_full = DVector::zeros(n_full);
+            sphi_full[3 * node + 2] = 1.0;
+            PointMap {
+                s0: Vector2::new(x, 0.0),
+                sp: pick_cols(&sp_full),
+                sphi: pick_v(&sphi_full),
+            }
+        };
+        let beam = PlanarBeam {
+            name: name.to_string(),
+            length,
+            elements,
+            frame,
+            section,
+            mu,
+            ea,
+            ej,
+            rayleigh_alpha,
+            rayleigh_beta,
+            mass,
+            st0: Vector2::new(mass * length / 2.0, 0.0),
+            i0: mass * length * length / 3.0,
+            sbar: pick_cols(&full.sbar),
+            a: pick_v(&full.a),
+            b: pick_v(&full.b),
+            w: pick(&full.w),
+            mff,
+            kff,
+            dff,
+            flange_a: node_map(0, 0.0),
+            flange_b: node_map(elements, length),
+            kept,
+            geometric_stiffening: options.geometric_stiffening,
+            options,
+            basis: None,
+            counts: TermCounts::default(),
+            band: Vec::new(),
+            strain: StrainRows::new(length / elements as f64),
+        };
+        match options.modes {
+            Some(k) => {
+                let k = k.min(beam.kept.len());
+                beam.truncated(k).banded()
+            }
+            None => beam.banded(),
+        }
+    }
+
+    /// The beam with its [`PlanarBeam::band`] found from its matrices.
+    fn banded(mut self) -> PlanarBeam {
+        let nf = self.mff.nrows();
+        self.band = (0..nf)
+            .map(|k| {
+                let nonzero = |l: usize| {
+                    self.mff[(k, l)] != 0.0
+                        || self.mff[(l, k)] != 0.0
+                        || self.w[(k, l)] != 0.0
+                        || self.w[(l, k)] != 0.0
+                        || self.kff[(k, l)] != 0.0
+                        || self.dff[(k, l)] != 0.0
+                };
+                let lo = (0..nf).find(|&l| nonzero(l)).unwrap_or(k);
+                let hi = (0..nf).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
+                lo..hi.max(lo)
+            })
+            .collect();
+        self
+    }
+
+    /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
+    /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
+    fn truncated(mut self, k: usize) -> PlanarBeam {
+        let phi = lowest_modes(&self.kff, &self.mff, k);
+        let pt = phi.transpose();
+        self.sbar = &self.sbar * &phi;
+        self.a = &pt * &self.a;
+        self.b = &pt * &self.b;
+        self.w = &pt * &self.w * &phi;
+        self.mff = &pt * &self.mff * &phi;
+        self.kff = &pt * &self.kff * &phi;
+        self.dff = &self.mff * self.rayleigh_alpha + &self.kff * self.rayleigh_beta;
+        for map in [&mut self.flange_a, &mut self.flange_b] {
+            reduce_map(map, &phi);
+        }
+        self.basis = Some(phi);
+        self
+    }
+
+    /// Nodal deformation (kept coordinates) of the body coordinates z.
+    fn nodal(&self, z: &DVectorView<f64>) -> DVector<f64> {
+        let f = z.rows(FLEX, self.nflex());
+        match &self.basis {
+            Some(phi) => phi * f,
+            None => f.into_owned(),
+        }
+    }
+
+    /// Largest transverse nodal displacement |v| from the frame's axis (m): how far this
+    /// frame's deformation is from the small-deformation range of a floating frame.
+    pub fn largest_transverse<'a>(&self, z: impl Coords<'a>) -> f64 {
+        let fq = self.nodal(&z.into());
+        self.kept
+            .iter()
+            .zip(fq.iter())
+            .filter(|(&k, _)| k % 3 == 1)
+            .fold(0.0, |m, (_, v)| m.max(v.abs()))
+    }
+
+    /// True if deformation coordinate k is a nodal slope (an angle), false for a length or a
+    /// modal amplitude.
+    pub fn is_slope(&self, k: usize) -> bool {
+        self.basis.is_none() && self.kept[k] % 3 == 2
+    }
+
+    /// Number of deformation coordinates nf (nodal, or modal under truncation).
+    pub fn nflex(&self) -> usize {
+        self.basis.as_ref().map_or(self.kept.len(), DMatrix::ncols)
+    }
+
+    /// Number of body coordinates 3 + nf.
+    pub fn ndof(&self) -> usize {
+        FLEX + self.nflex()
+    }
+
+    /// Reduced index of the full nodal coordinate `full`, if the boundary conditions keep it.
+    pub fn flex_index(&self, full: usize) -> Option<usize> {
+        self.kept.iter().position(|&k| k == full)
+    }
+
+    /// First moment c = ∫ρ ū dV = S̄_t0 + S̄ q_f in the beam frame.
+    fn first_moment(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        self.st0 + self.sbar_mul(f)
+    }
+
+    /// S̄ f for deformation coordinates or their rates.
+    fn sbar_mul(&self, f: &DVectorView<f64>) -> Vector2<f64> {
+        let mut c = Vector2::zeros();
+        for k in 0..f.len() {
+            c += col2(&self.sbar, k) * f[k];
+        }
+        c
+    }
+
+    /// Mass matrix M(z), written into `m` (ndof × ndof).
+    pub fn mass_matrix<'a>(&self, z: impl Coords<'a>, mut m: DMatrixViewMut<f64>) {
+        let z = z.into();
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf);
+        let (ar, ath) = rot(z[THETA]);
+        let c = self.first_moment(&f);
+        let athc = ath * c;
+        m.fill(0.0);
+        m[(0, 0)] = self.mass;
+        m[(1, 1)] = self.mass;
+        for i in 0..2 {
+            m[(i, THETA)] = athc[i];
+            m[(THETA, i)] = athc[i];
+        }
+        let mut mthth = self.i0;
+        for k in 0..nf {
+            let asbar = ar * col2(&self.sbar, k);
+            for i in 0..2 {
+                m[(i, FLEX + k)] = asbar[i];
+                m[(FLEX + k, i)] = asbar[i];
+            }
+            let (mut mff_f, mut wt_f) = (0.0, 0.0);
+            for l in self.band[k].clone() {
+                mff_f += self.mff[(k, l)] * f[l];
+                wt_f += self.w[(l, k)] * f[l];
+            }
+            mthth += 2.0 * self.a[k] * f[k] + f[k] * mff_f;
+            let mthf = self.b[k] + wt_f;
+            m[(THETA, FLEX + k)] = mthf;
+            m[(FLEX + k, THETA)] = mthf;
+        }
+        m[(THETA, THETA)] = mthth;
+        m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);
+    }
+
+    /// Residual r = M z̈ + h + internal - gravity, added into `r`. Gravity is `None` when the
+    /// effect is off; the options say which other terms are computed.
+    pub fn residual<'a>(
+        &self,
+        z: impl Coords<'a>,
+        zd: impl Coords<'a>,
+        zdd: impl Coords<'a>,
+        gravity: Option<Vector2<f64>>,
+        r: &mut [f64],
+    ) {
+        let (qv, damping) = (self.options.quadratic_velocity, self.options.damping);
+        self.count_terms(gravity.is_some());
+        let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf);
+        let fd = zd.rows(FLEX, nf);
+        let fdd = zdd.rows(FLEX, nf);
+        let (ar, ath) = rot(z[THETA]);
+        let (td, tdd) = (zd[THETA], zdd[THETA]);
+        let rdd = Vector2::new(zdd[0], zdd[1]);
+        let c = self.first_moment(&f);
+        let (ac, athc) = (ar * c, ath * c);
+        let sbar_fd = self.sbar_mul(&fd);
+        let sbar_fdd = self.sbar_mul(&fdd);
+        // translation
+        let mut r_r = rdd * self.mass + athc * tdd + ar * sbar_fdd;
+        if qv {
+            r_r += ath * sbar_fd * (2.0 * td) - ac * (td * td);
+        }
+        if let Some(g) = gravity {
+            r_r -= g * self.mass;
+        }
+        r[0] += r_r[0];
+        r[1] += r_r[1];
+        // deformation, with the sums the rotation row needs
+        let local = ar.transpose() * gravity.map_or(rdd, |g| rdd - g);
+        let (mut a_f, mut f_mff_f, mut mthf_fdd, mut af_fd) = (0.0, 0.0, 0.0, 0.0);
+        for k in 0..nf {
+            let (mut mff_f, mut mff_fdd, mut wt_f, mut kff_f) = (0.0, 0.0, 0.0, 0.0);
+            for l in self.band[k].clone() {
+                mff_f += self.mff[(k, l)] * f[l];
+                mff_fdd += self.mff[(k, l)] * fdd[l];
+                wt_f += self.w[(l, k)] * f[l];
+                kff_f += self.kff[(k, l)] * f[l];
+            }
+            let mthf = self.b[k] + wt_f; // Ī_θf
+            a_f += self.a[k] * f[k];
+            f_mff_f += f[k] * mff_f;
+            mthf_fdd += mthf * fdd[k];
+            let mut rk = col2(&self.sbar, k).dot(&local) + mthf * tdd + mff_fdd + kff_f;
+            if qv {
+                let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
+                af_fd += af * fd[k];
+                let w_fd: f64 = self.band[k].clone().map(|l| self.w[(k, l)] * fd[l]).sum();
+                rk -= af * (td * td) + w_fd * (2.0 * td);
+            }
+            if damping {
+                rk += self.band[k]
+                    .clone()
+                    .map(|l| self.dff[(k, l)] * fd[l])
+                    .sum::<f64>();
+            }
+            r[FLEX + k] += rk;
+        }
+        // rotation
+        let mthth = self.i0 + 2.0 * a_f + f_mff_f;
+        r[THETA] += athc.dot(&rdd) + mthth * tdd + mthf_fdd;
+        if qv {
+            r[THETA] += 2.0 * td * af_fd;
+        }
+        if let Some(g) = gravity {
+            r[THETA] -= athc.dot(&g);
+        }
+        if self.geometric_stiffening {
+            self.stiffening_force(&z, &mut r[FLEX..FLEX + nf]);
+        }
+    }
+
+    /// Counts one evaluation of each optional term that is on.
+    fn count_terms(&self, gravity: bool) {
+        let c = &self.counts;
+        let o = &self.options;
+        for (on, cell) in [
+            (gravity, &c.gravity),
+            (o.quadratic_velocity, &c.quadratic_velocity),
+            (o.damping, &c.damping),
+            (self.geometric_stiffening, &c.geometric_stiffening),
+            (o.axial, &c.axial),
+        ] {
+            if on {
+                TermCounts::bump(cell);
+            }
+        }
+    }
+
+    /// Tangents of the residual: K_t = ∂r/∂z (at fixed ż, z̈) and C_t = ∂r/∂ż, added into the
+    /// given blocks (ndof × ndof).
+    pub fn tangents<'a>(
+        &self,
+        z: impl Coords<'a>,
+        zd: impl Coords<'a>,
+        zdd: impl Coords<'a>,
+        gravity: Option<Vector2<f64>>,
+        mut kt: DMatrixViewMut<f64>,
+        mut ct: DMatrixViewMut<f64>,
+    ) {
+        let (qv, damping) = (self.options.quadratic_velocity, self.options.damping);
+        self.count_terms(gravity.is_some());
+        let (z, zd, zdd) = (z.into(), zd.into(), zdd.into());
+        let nf = self.nflex();
+        let f = z.rows(FLEX, nf);
+        let fd = zd.rows(FLEX, nf);
+        let fdd = zdd.rows(FLEX, nf);
+        let (ar, ath) = rot(z[THETA]);
+        let (td, tdd) = (zd[THETA], zdd[THETA]);
+        let rdd = Vector2::new(zdd[0], zdd[1]);
+        let c = self.first_moment(&f);
+        let (ac, athc) = (ar * c, ath * c);
+        let sbar_fd = self.sbar_mul(&fd);
+        let sbar_fdd = self.sbar_mul(&fdd);
+        // ∂r_R/∂θ
+        let mut d_r_th = -ac * tdd + ath * sbar_fdd;
+        if qv {
+            d_r_th -= athc * (td * td) + ar * sbar_fd * (2.0 * td);
+            // ∂r_R/∂θ̇
+            let d_r_thd = -ac * (2.0 * td) + ath * sbar_fd * 2.0;
+            for i in 0..2 {
+                ct[(i, THETA)] += d_r_thd[i];
+            }
+        }
+        for i in 0..2 {
+            kt[(i, THETA)] += d_r_th[i];
+        }
+        // ∂r_θ/∂θ
+        // the frame's acceleration less gravity: the inertial load on the deformation
+        let accel = gravity.map_or(rdd, |g| rdd - g);
+        kt[(THETA, THETA)] -= ac.dot(&accel);
+        let mut af_fd = 0.0;
+        for k in 0..nf {
+            let (asbar, athsbar) = (ar * col2(&self.sbar, k), ath * col2(&self.sbar, k));
+            let (mut mff_f, mut w_fdd) = (0.0, 0.0);
+            for l in self.band[k].clone() {
+                mff_f += self.mff[(k, l)] * f[l];
+                w_fdd += self.w[(k, l)] * fdd[l];
+            }
+            let af = self.a[k] + mff_f;
+            // ∂r_R/∂f, ∂r_R/∂ḟ
+            let mut d_r_f = athsbar * tdd;
+            // ∂r_θ/∂f, ∂r_f/∂θ
+            let d_f_th = athsbar.dot(&accel);
+            kt[(THETA, FLEX + k)] += d_f_th + af * (2.0 * tdd) + w_fdd;
+            kt[(FLEX + k, THETA)] += d_f_th;
+            if qv {
+                let (mut mff_fd, mut w_fd) = (0.0, 0.0);
+                for l in self.band[k].clone() {
+                    mff_fd += self.mff[(k, l)] * fd[l];
+                    w_fd += self.w[(k, l)] * fd[l];
+                }
+                af_fd += af * fd[k];
+                d_r_f -= asbar * (td * td);
+                for i in 0..2 {
+                    ct[(i, FLEX + k)] += 2.0 * td * athsbar[i];
+                }
+                kt[(THETA, FLEX + k)] += mff_fd * (2.0 * td);
+                // ∂r_θ/∂ḟ, ∂r_f/∂θ̇
+                ct[(THETA, FLEX + k)] += 2.0 * td * af;
+                ct[(FLEX + k, THETA)] += af * (-2.0 * td) - w_fd * 2.0;
+            }
+            for i in 0..2 {
+                kt[(i, FLEX + k)] += d_r_f[i];
+            }
+        }
+        if qv {
+            ct[(THETA, THETA)] += 2.0 * af_fd;
+        }
+        // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff, ∂r_f/∂ḟ = -2θ̇ W + D_ff
+        for k in 0..nf {
+            for l in self.band[k].clone() {
+                kt[(FLEX + k, FLEX + l)] += self.w[(l, k)] * tdd + self.kff[(k, l)];
+            }
+        }
+        if qv {
+            for k in 0..nf {
+                for l in self.band[k].clone() {
+                    kt[(FLEX + k, FLEX + l)] -= td * td * self.mff[(k, l)];
+                    ct[(FLEX + k, FLEX + l)] -= 2.0 * td * self.w[(k, l)];
+                }
+            }
+        }
+        if damping {
+            let mut c = ct.view_mut((FLEX, FLEX), (nf, nf));
+            c += &self.dff;
+        }
+        if self.geometric_stiffening {
+            self.stiffening_tangent(&z, &mut kt);
+        }
+    }
+
+    /// Kinetic energy ½ żᵀ M ż (J).
+    pub fn kinetic_energy<'a>(&self, z: impl Coords<'a>, zd: impl Coords<'a>) -> f64 {
+        let n = self.ndof();
+        let mut m = DMatrix::zeros(n, n);
+        self.mass_matrix(z, m.view_mut((0, 0), (n, n)));
+        let zd = zd.into();
+        0.5 * zd.dot(&(&m * zd))
+    }
+
+    /// Strain energy ½ q_fᵀ K_ff q_f (J).
+    pub fn strain_energy<'a>(&self, z: impl Coords<'a>) -> f64 {
+        let z = z.into();
+        let f = z.rows(FLEX, self.nflex());
+        let extra = if self.geometric_stiffening {
+            self.stiffening_energy(&z)
+        } else {
+            0.0
+        };
+        0.5 * f.dot(&(&self.kff * f)) + extra
+    }
+
+    /// Potential energy of gravity -g·∫ρ r dV (J).
+    pub fn gravity_energy<'a>(&self, z: impl Coords<'a>, gravity: Option<Vector2<f64>>) -> f64 {
+        let Some(gravity) = gravity else { return 0.0 };
+        let z = z.into();
+        let f = z.rows(FLEX, self.nflex());
+        let (ar, _) = rot(z[THETA]);
+        let com = Vector2::new(z[0], z[1]) * self.mass + ar * self.first_moment(&f);
+        -gravity.dot(&com)
+    }
+
+    /// World position and angle of a material point map, and their Jacobians over z.
+    pub fn point<'a>(&self, map: &PointMap, z: impl Coords<'a>) -> (Vector2<f64>, f64) {
+        let z = z.into();
+        let f = z.rows(FLEX, self.nflex());
+        let (ar, _) = rot(z[THETA]);
+        let s = map.s0 + map.displacement(&f);
+        (
+            Vector2::new(z[0], z[1]) + ar * s,
+            z[THETA] + map.sphi.dot(&f),
+        )
+    }
+
+    /// Position of the map in the beam frame, s = s0 + S_p q_f.
+    pub fn local_point<'a>(&self, map: &PointMap, z: impl Coords<'a>) -> Vector2<f64> {
+        map.s0 + map.displacement(&z.into().rows(FLEX, self.nflex()))
+    }
+
+    /// The material point at distance x from flange a along the undeformed axis.
+    pub fn point_map(&self, x: f64) -> PointMap {
+        let l = self.length / self.elements as f64;
+        let j = ((x / l).floor() as usize).min(self.elements - 1);
+        let xi = (x / l - j as f64).clamp(0.0, 1.0);
+        let (s1, s2) = planar_element::shape(xi, l);
+        let sl = planar_element::slope(xi, l);
+        let nk = self.kept.len();
+        let mut sp = DMatrix::zeros(2, nk);
+        let mut sphi = DVector::zeros(nk);
+        for p in 0..ELEMENT_DOFS {
+            if let Some(k) = self.flex_index(3 * j + p) {
+                sp[(0, k)] = s1[p];
+                sp[(1, k)] = s2[p];
+                sphi[k] = sl[p];
+            }
+        }
+        let mut map = PointMap {
+            s0: Vector2::new(x, 0.0),
+            sp,
+            sphi,
+        };
+        if let Some(phi) = &self.basis {
+            reduce_map(&mut map, phi);
+        }
+        map
+    }
+
+    pub fn set_geometric_stiffening(&mut self, on: bool) {
+        self.geometric_stiffening = on;
+    }
+
+    /// Visits each element with its axial strain ε = u' + ½⟨v'²⟩, the element mean of v'²
+    /// making ε (and the axial force) constant per element, which avoids membrane locking:
+    /// (kept index of each element coordinate, ℓ, ε, ∂ε/∂q_e, ⟨v'_q v'_qᵀ⟩).
+    #[allow(clippy::type_complexity)]
+    fn for_element_strains(
+        &self,
+        fq: &DVector<f64>,
+        mut visit: impl FnMut(
+            &[Option<usize>; ELEMENT_DOFS],
+            f64,
+            f64,
+            &[f64; ELEMENT_DOFS],
+            &[[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
+        ),
+    ) {
+        let l = self.length / self.elements as f64;
+        let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+        let (slopes, hv) = (&self.strain.slopes, &self.strain.hv);
+        for j in 0..self.elements {
+            let idx: [Option<usize>; ELEMENT_DOFS] =
+                std::array::from_fn(|p| self.flex_index(3 * j + p));
+            let qe: [f64; ELEMENT_DOFS] = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
+            let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
+            let mut de = da;
+            for (ds, &(_, w)) in slopes.iter().zip(&GAUSS_4) {
+                let dv: f64 = (0..ELEMENT_DOFS).map(|p| ds[p] * qe[p]).sum();
+                eps += 0.5 * w * dv * dv;
+                for p in 0..ELEMENT_DOFS {
+                    de[p] += w * dv * ds[p];
+                }
+            }
+            visit(&idx, l, eps, &de, hv);
+        }
+    }
+
+    /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
+    /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out` (projected on the modes under
+    /// truncation).
+    fn stiffening_force(&self, z: &DVectorView<f64>, out: &mut [f64]) {
+        let ea = self.ea;
+        let fq = self.nodal(z);
+        let mut nodal = DVector::zeros(self.kept.len());
+        self.for_element_strains(&fq, |idx, l, eps, de, _| {
+            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
+            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+            for p in 0..ELEMENT_DOFS {
+                if let Some(k) = idx[p] {
+                    nodal[k] += ea * l * (eps * de[p] - du * da[p]);
+                }
+            }
+        });
+        let projected = match &self.basis {
+            Some(phi) => phi.tr_mul(&nodal),
+            None => nodal,
+        };
+        for (o, x) in out.iter_mut().zip(projected.iter()) {
+            *o += x;
+        }
+    }
+
+    /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
+    fn stiffening_tangent(&self, z: &DVectorView<f64>, kt: &mut DMatrixViewMut<f64>) {
+        let ea = self.ea;
+        let fq = self.nodal(z);
+        let nk = self.kept.len();
+        let mut nodal = DMatrix::zeros(nk, nk);
+        self.for_element_strains(&fq, |idx, l, eps, de, hv| {
+            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+            for p in 0..ELEMENT_DOFS {
+                let Some(kp) = idx[p] else { continue };
+                for r in 0..ELEMENT_DOFS {
+                    let Some(kr) = idx[r] else { continue };
+                    nodal[(kp, kr)] += ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
+                }
+            }
+        });
+        let nf = self.nflex();
+        let mut block = kt.view_mut((FLEX, FLEX), (nf, nf));
+        match &self.basis {
+            Some(phi) => block += phi.tr_mul(&nodal) * phi,
+            None => block += nodal,
+        }
+    }
+
+    /// Strain energy of the nonlinear strain beyond ½ q_fᵀ K_ff q_f.
+    fn stiffening_energy(&self, z: &DVectorView<f64>) -> f64 {
+        let mut e = 0.0;
+        let ea = self.ea;
+        let fq = self.nodal(z);
+        self.for_element_strains(&fq, |idx, l, eps, _, _| {
+            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
+            e += 0.5 * ea * l * (eps * eps - du * du);
+        });
+        e
+    }
+
+    /// Static deformation under a transverse tip force, scaled to a tip displacement `tip`
+    /// (tangent frame): the initial shape of case C1.
+    /// Under modal truncation the shape is the static solution within the kept modes.
+    pub fn static_tip_shape(&self, tip: f64) -> Option<DVector<f64>> {
+        // the tip's transverse displacement per coordinate: the unit tip load, by reciprocity
+        let load = self.flange_b.sp.row(1).transpose();
+        if load.amax() == 0.0 {
+            return None; // the frame holds the tip
+        }
+        let q = self.kff.clone().lu().solve(&load)?;
+        let scale = tip / load.dot(&q);
+        scale.is_finite().then(|| q * scale)
+    }
+}
+
+/// Integrals of eq. (11) over all N elements, before boundary conditions (eq. (8)–(12)).
+fn full_integrals(length: f64, elements: usize, mu: f64, ea: f64, ej: f64) -> FullIntegrals {
+    let n_full = 3 * (elements + 1);
+    let l = length / elements as f64;
+    let mut out = FullIntegrals {
+        sbar: DMatrix::zeros(2, n_full),
+        a: DVector::zeros(n_full),
+        b: DVector::zeros(n_full),
+        mff: DMatrix::zeros(n_full, n_full),
+        w: DMatrix::zeros(n_full, n_full),
+        kff: DMatrix::zeros(n_full, n_full),
+    };
+    let ke = planar_element::stiffness(ea, ej, l);
+    for j in 0..elements {
+        let o = 3 * j; // the connectivity matrix B_j of eq. (9)
+        for &(xi, wgt) in &GAUSS_4 {
+            let (s1, s2) = planar_element::shape(xi, l);
+            let dm = mu * l * wgt;
+            let x0 = (j as f64 + xi) * l;
+            for p in 0..ELEMENT_DOFS {
+                out.sbar[(0, o + p)] += dm * s1[p];
+                out.sbar[(1, o + p)] += dm * s2[p];
+                out.a[o + p] += dm * s1[p] * x0;
+                out.b[o + p] += dm * s2[p] * x0;
+                for q in 0..ELEMENT_DOFS {
+                    out.mff[(o + p, o + q)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
+                    out.w[(o + p, o + q)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
+                }
+            }
+        }
+        for p in 0..ELEMENT_DOFS {
+            for q in 0..ELEMENT_DOFS {
+                out.kff[(o + p, o + q)] += ke[p][q];
+            }
+        }
+    }
+    out
+}
+
+/// Expresses a point map in modal coordinates: S_p Φ and Φᵀ S_φ.
+fn reduce_map(map: &mut PointMap, phi: &DMatrix<f64>) {
+    map.sp = &map.sp * phi;
+    map.sphi = phi.tr_mul(&map.sphi);
+}
+
+/// The lowest `k` modes of K φ = ω² M φ (columns, ascending ω, Φᵀ M Φ = I), through the
+/// Cholesky factor of the (positive definite) mass matrix.
+pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix<f64> {
+    let l = mff
+        .clone()
+        .cholesky()
+        .expect("the consistent mass matrix is positive definite")
+        .l();
+    let linv = l
+        .clone()
+        .try_inverse()
+        .expect("a Cholesky factor is invertible");
+    let a = &linv * kff * linv.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = a.symmetric_eigen();
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let cols: Vec<_> = order[..k]
+        .iter()
+        .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
+        .collect();
+    DMatrix::from_columns(&cols)
+}

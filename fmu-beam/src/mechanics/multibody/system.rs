@@ -1,0 +1,1033 @@
+//! The assembled multibody system: bodies stacked in q, joint equations stacked in g.
+//!
+//! Residual of the equations of motion (what the integrator drives to zero):
+//! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
+
+use super::body::Body;
+use super::equations::Turning;
+use super::frame::{self, Frame, FrameState};
+use super::joint::{Drive, Joint, Rows};
+use super::law::{InputValue, TimeLaw};
+use super::rigid_body::RigidBody;
+use super::sparsity::{BlockDiagonal, JacobianRows};
+use crate::error::EngineError;
+use crate::mechanics::beam::planar_beam::TermCounts;
+use crate::mechanics::beam::planar_beam::{rot, PlanarBeam, PointMap, THETA};
+use crate::mechanics::Effects;
+use crate::scene::{DriveKind, JointKind, Scene};
+use nalgebra::{DMatrix, DVector, DVectorView, Vector2};
+use std::ops::Range;
+
+/// Energies of the system (J).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub strain: f64,
+    pub potential: f64,
+}
+
+impl Energy {
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.strain + self.potential
+    }
+}
+
+/// An FMU input of the scene, in slot order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSlot {
+    pub name: String,
+    pub unit: &'static str,
+    pub start: f64,
+    pub description: String,
+}
+
+/// The FMU inputs a scene offers: drives with law "input", then loads marked `input`.
+pub fn input_slots(scene: &Scene) -> Vec<InputSlot> {
+    let mut slots = Vec::new();
+    for j in &scene.joints {
+        if let Some(d) = j.drive.as_ref().filter(|d| d.law.law == "input") {
+            let (what, unit) = match (j.kind, d.kind) {
+                (JointKind::Prismatic, DriveKind::Motion) => ("position", "m"),
+                (JointKind::Prismatic, DriveKind::Effort) => ("force", "N"),
+                (_, DriveKind::Motion) => ("angle", "rad"),
+                (_, DriveKind::Effort) => ("torque", "N.m"),
+            };
+            slots.push(InputSlot {
+                name: format!("{}.drive.{what}", j.name),
+                unit,
+                start: d.law.value.unwrap_or(0.0),
+                description: format!("Drive of joint {}: prescribed {what}", j.name),
+            });
+        }
+    }
+    for l in scene.loads.iter().filter(|l| l.input) {
+        let planar = [
+            ("fx", "N", l.force[0]),
+            ("fy", "N", l.force[1]),
+            ("torque", "N.m", l.torque[2]),
+        ];
+        let spatial = [
+            ("fx", "N", l.force[0]),
+            ("fy", "N", l.force[1]),
+            ("fz", "N", l.force[2]),
+            ("tx", "N.m", l.torque[0]),
+            ("ty", "N.m", l.torque[1]),
+            ("tz", "N.m", l.torque[2]),
+        ];
+        let parts: &[(&str, &'static str, f64)] = if scene.is_3d() { &spatial } else { &planar };
+        for &(what, unit, start) in parts {
+            slots.push(InputSlot {
+                name: format!("{}.{what}", l.name),
+                unit,
+                start,
+                description: format!("Load {} on {}: {what} (world axes)", l.name, l.frame),
+            });
+        }
+    }
+    slots
+}
+
+/// A point load: world force and torque on a frame, constant or from input slots.
+#[derive(Debug, Clone)]
+pub struct Load {
+    pub name: String,
+    pub frame: usize,
+    pub force: Vector2<f64>,
+    pub torque: f64,
+    /// Input slots of fx, fy, torque.
+    pub inputs: Option<usize>,
+    /// A time law that scales the constant force and torque (a ramp, say).
+    pub scale: Option<TimeLaw>,
+}
+
+/// A scene beam: one body, or k substructures welded tip to root.
+#[derive(Debug, Clone)]
+pub struct BeamGroup {
+    pub name: String,
+    pub bodies: Range<usize>,
+    pub length: f64,
+    pub pinned: bool,
+    pub section: crate::mechanics::beam::section::Section,
+    /// The material point at mid-span.
+    pub mid: (usize, PointMap),
+}
+
+#[derive(Debug, Clone)]
+pub struct System {
+    pub bodies: Vec<Body>,
+    /// Index of each body's first coordinate in q.
+    pub offsets: Vec<usize>,
+    pub frames: Vec<Frame>,
+    pub joints: Vec<Joint>,
+    pub loads: Vec<Load>,
+    pub beams: Vec<BeamGroup>,
+    /// The gravity field, `None` when the effect is off (its terms are not evaluated).
+    pub gravity: Option<Vector2<f64>>,
+    /// The resolved effects the system was built with.
+    pub effects: Effects,
+    /// Current values of the FMU inputs (slot order of [`input_slots`]).
+    pub inputs: Vec<InputValue>,
+    n: usize,
+    m: usize,
+}
+
+impl System {
+    /// Assembles the system of a validated scene computing the given effects (resolved from
+    /// this scene, or from the packaged scene of which this one has other parameter values).
+    pub fn build(scene: &Scene, effects: &Effects) -> System {
+        let mut bodies = Vec::new();
+        let mut beams = Vec::new();
+        for (spec, fx) in scene.beams.iter().zip(&effects.beams) {
+            let (_, k) = Scene::beam_layout(spec);
+            let k = if fx.rigid { 1 } else { k };
+            let first = bodies.len();
+            let section = crate::mechanics::beam::section::Section::from_spec(&spec.section);
+            if fx.rigid {
+                let mass = spec.material.rho * section.area * spec.length;
+                bodies.push(Body::Rigid(RigidBody {
+                    name: spec.name.clone(),
+                    mass,
+                    com: Vector2::new(spec.length / 2.0, 0.0),
+                    inertia: mass * spec.length * spec.length / 12.0,
+                    frames: vec![
+                        ("a".into(), Vector2::zeros()),
+                        ("b".into(), Vector2::new(spec.length, 0.0)),
+                    ],
+                    counts: Default::default(),
+                }));
+            } else {
+                let ls = spec.length / k as f64;
+                for i in 0..k {
+                    let name = if k == 1 {
+                        spec.name.clone()
+                    } else {
+                        format!("{}[{i}]", spec.name)
+                    };
+                    let b = PlanarBeam::part_of(spec, &name, ls, fx.options);
+                    bodies.push(Body::Beam(Box::new(b)));
+                }
+            }
+            let range = first..bodies.len();
+            // mid-span: x = L/2 lies in substructure floor(k/2) (at its flange a when k is even)
+            let idx = (range.len() / 2).min(range.len() - 1);
+            let mid_body = first + idx;
+            let local_x = spec.length / 2.0 - idx as f64 * spec.length / range.len() as f64;
+            let mid_map = match &bodies[mid_body] {
+                Body::Beam(b) => b.point_map(local_x),
+                Body::Rigid(_) => PointMap {
+                    s0: Vector2::new(local_x, 0.0),
+                    sp: DMatrix::zeros(2, 0),
+                    sphi: DVector::zeros(0),
+                },
+            };
+            beams.push(BeamGroup {
+                name: spec.name.clone(),
+                bodies: range,
+                length: spec.length,
+                pinned: spec.frame == crate::scene::FrameKind::Pinned,
+                section,
+                mid: (mid_body, mid_map),
+            });
+        }
+        for spec in &scene.bodies {
+            bodies.push(Body::Rigid(RigidBody {
+                name: spec.name.clone(),
+                mass: spec.mass,
+                com: Vector2::new(spec.com[0], spec.com[1]),
+                inertia: spec.inertia[2],
+                frames: spec
+                    .frames
+                    .iter()
+                    .map(|(n, p)| (n.clone(), Vector2::new(p.0[0], p.0[1])))
+                    .collect(),
+                counts: Default::default(),
+            }));
+        }
+        let mut offsets = Vec::with_capacity(bodies.len());
+        let mut n = 0;
+        for b in &bodies {
+            offsets.push(n);
+            n += b.ndof();
+        }
+        let mut sys = System {
+            bodies,
+            offsets,
+            frames: Vec::new(),
+            joints: Vec::new(),
+            loads: Vec::new(),
+            beams,
+            gravity: effects
+                .gravity
+                .then(|| Vector2::new(scene.world.gravity[0], scene.world.gravity[1])),
+            effects: effects.clone(),
+            inputs: input_slots(scene)
+                .iter()
+                .map(|s| InputValue {
+                    value: s.start,
+                    ..Default::default()
+                })
+                .collect(),
+            n,
+            m: 0,
+        };
+        let q0 = sys.placed_coordinates(scene);
+        // substructure welds: flange b of each frame to flange a of the next
+        let mut internal = Vec::new();
+        for g in sys.beams.clone() {
+            for i in g.bodies.start..g.bodies.end.saturating_sub(1) {
+                if let (Body::Beam(b0), Body::Beam(b1)) = (&sys.bodies[i], &sys.bodies[i + 1]) {
+                    let (m0, m1) = (b0.flange_b.clone(), b1.flange_a.clone());
+                    let f0 = sys.add_frame(Frame::OnBody { body: i, map: m0 });
+                    let f1 = sys.add_frame(Frame::OnBody {
+                        body: i + 1,
+                        map: m1,
+                    });
+                    internal.push((
+                        format!("{}.substructure{}", g.name, i + 1 - g.bodies.start),
+                        f0,
+                        f1,
+                    ));
+                }
+            }
+        }
+        let mut row = 0;
+        for (name, f0, f1) in internal {
+            let offset = sys.relative_angle(f0, f1, &q0);
+            sys.joints.push(Joint {
+                name,
+                kind: JointKind::Weld,
+                frames: [f0, f1],
+                axis_angle: 0.0,
+                angle_offset: offset,
+                drive: None,
+                row,
+            });
+            row += 3;
+        }
+        let slots = input_slots(scene);
+        for j in &scene.joints {
+            let f0 = sys.frame_by_name(&j.frames[0]);
+            let f1 = sys.frame_by_name(&j.frames[1]);
+            let drive = Drive::of_joint(j, &slots);
+            let offset = sys.relative_angle(f0, f1, &q0);
+            let count = Joint::rows_count(j.kind, drive.as_ref());
+            sys.joints.push(Joint {
+                name: j.name.clone(),
+                kind: j.kind,
+                frames: [f0, f1],
+                axis_angle: j.axis_angle,
+                angle_offset: offset,
+                drive,
+                row,
+            });
+            row += count;
+        }
+        sys.m = row;
+        for l in &scene.loads {
+            let frame = sys.frame_by_name(&l.frame);
+            let inputs = l
+                .input
+                .then(|| {
+                    slots
+                        .iter()
+                        .position(|s| s.name == format!("{}.fx", l.name))
+                })
+                .flatten();
+            sys.loads.push(Load {
+                name: l.name.clone(),
+                frame,
+                force: Vector2::new(l.force[0], l.force[1]),
+                torque: l.torque[2],
+                inputs,
+                scale: l.scale.as_ref().map(|s| TimeLaw::from_spec(s, None)),
+            });
+        }
+        sys
+    }
+
+    fn add_frame(&mut self, f: Frame) -> usize {
+        self.frames.push(f);
+        self.frames.len() - 1
+    }
+
+    /// Resolves a (validated) frame name of the scene.
+    fn frame_by_name(&mut self, name: &str) -> usize {
+        if name == "world" {
+            return self.add_frame(Frame::World {
+                position: Vector2::zeros(),
+                angle: 0.0,
+            });
+        }
+        let (owner, f) = name.split_once('.').unwrap_or((name, "origin"));
+        let frame = if let Some(g) = self.beams.iter().find(|g| g.name == owner) {
+            let body = if f == "a" {
+                g.bodies.start
+            } else {
+                g.bodies.end - 1
+            };
+            let map = match &self.bodies[body] {
+                Body::Beam(b) if f == "a" => b.flange_a.clone(),
+                Body::Beam(b) => b.flange_b.clone(),
+                Body::Rigid(r) => r.frame_map(f).expect("validated frame"),
+            };
+            Frame::OnBody { body, map }
+        } else {
+            let body = self
+                .bodies
+                .iter()
+                .position(|b| b.name() == owner)
+                .expect("validated body");
+            let map = match &self.bodies[body] {
+                Body::Rigid(r) => r.frame_map(f).expect("validated frame"),
+                Body::Beam(b) => b.flange_a.clone(),
+            };
+            Frame::OnBody { body, map }
+        };
+        self.add_frame(frame)
+    }
+
+    fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>) -> f64 {
+        self.frame_state(f1, q, None).phi - self.frame_state(f0, q, None).phi
+    }
+
+    /// Number of coordinates.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Number of constraint equations.
+    pub fn m(&self) -> usize {
+        self.m
+    }
+
+    /// The largest body length (m): the scale of position errors.
+    pub fn length_scale(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(Body::length_scale)
+            .fold(0.0, f64::max)
+            .max(1e-3)
+    }
+
+    /// The flexible beam that is body `i`, if it is one.
+    pub fn beam(&self, i: usize) -> Option<&PlanarBeam> {
+        match &self.bodies[i] {
+            Body::Beam(b) => Some(b),
+            Body::Rigid(_) => None,
+        }
+    }
+
+    /// Indices in q of the frame coordinates (x, y, θ) of every body, not its deformation.
+    pub fn frame_coordinates(&self) -> Vec<usize> {
+        self.offsets.iter().flat_map(|&o| o..o + 3).collect()
+    }
+
+    /// The unknowns that turn with the whole system: each body's (x, y) and angle, and the
+    /// p₁ - p₀ rows of revolute and weld joints (the first two of each, along the world axes).
+    pub fn turning(&self) -> Turning {
+        let angles = self.offsets.iter().map(|&o| o + THETA).collect();
+        let mut pairs: Vec<usize> = self.offsets.clone();
+        for j in &self.joints {
+            if matches!(
+                j.kind,
+                JointKind::Weld | JointKind::Revolute | JointKind::Spherical
+            ) {
+                pairs.push(self.n + j.row);
+            }
+        }
+        Turning { angles, pairs }
+    }
+
+    /// Coordinates of body `i`.
+    pub fn body_coords<'a>(&self, i: usize, q: &'a DVector<f64>) -> DVectorView<'a, f64> {
+        q.rows(self.offsets[i], self.bodies[i].ndof())
+    }
+
+    /// Coordinates of the scene's placement, before assembly: frames where the scene puts
+    /// them, substructures in a row along their beam, and the initial deformed shapes.
+    fn placed_coordinates(&self, scene: &Scene) -> DVector<f64> {
+        let mut q = DVector::zeros(self.n);
+        for (g, spec) in self.beams.iter().zip(&scene.beams) {
+            let k = g.bodies.len();
+            let (ar, _) = rot(spec.angle);
+            for (i, body) in g.bodies.clone().enumerate() {
+                let o = self.offsets[body];
+                let p = Vector2::new(spec.position[0], spec.position[1])
+                    + ar * Vector2::new(i as f64 * spec.length / k as f64, 0.0);
+                q[o] = p[0];
+                q[o + 1] = p[1];
+                q[o + 2] = spec.angle;
+            }
+        }
+        let first_rigid = self.beams.last().map_or(0, |g| g.bodies.end);
+        for (i, spec) in scene.bodies.iter().enumerate() {
+            let o = self.offsets[first_rigid + i];
+            q[o] = spec.position[0];
+            q[o + 1] = spec.position[1];
+            q[o + 2] = spec.angle;
+        }
+        q
+    }
+
+    /// Initial coordinates from the scene: placement plus the initial deformed shapes.
+    pub fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+        let mut q = self.placed_coordinates(scene);
+        for (g, spec) in self.beams.iter().zip(&scene.beams) {
+            if spec.initial.tip_displacement == 0.0 {
+                continue;
+            }
+            let body = g.bodies.start;
+            let b = self.beam(body).ok_or_else(|| EngineError::InitialState {
+                message: format!("beam '{}' is rigid: it has no initial deformation", g.name),
+            })?;
+            let shape = b
+                .static_tip_shape(spec.initial.tip_displacement)
+                .ok_or_else(|| EngineError::InitialState {
+                    message: format!(
+                        "beam '{}': no static tip shape (is the tip held by the frame?)",
+                        b.name
+                    ),
+                })?;
+            q.rows_mut(self.offsets[body] + 3, b.nflex())
+                .copy_from(&shape);
+        }
+        Ok(q)
+    }
+
+    /// Kinematics of frame `f` (at rest without rates).
+    pub fn frame_state(
+        &self,
+        f: usize,
+        q: &DVector<f64>,
+        v: Option<&DVector<f64>>,
+    ) -> FrameState<'_> {
+        match &self.frames[f] {
+            Frame::World { position, angle } => FrameState::world(*position, *angle),
+            Frame::OnBody { body, map } => FrameState::on_body(
+                *body,
+                &self.bodies[*body],
+                map,
+                self.body_coords(*body, q),
+                v.map(|v| self.body_coords(*body, v)),
+            ),
+        }
+    }
+
+    /// The rows of joint `j` at (q, q', t) (at rest without rates).
+    pub fn joint_rows(
+        &self,
+        j: &Joint,
+        q: &DVector<f64>,
+        v: Option<&DVector<f64>>,
+        t: f64,
+    ) -> (FrameState<'_>, FrameState<'_>, Rows) {
+        let f0 = self.frame_state(j.frames[0], q, v);
+        let f1 = self.frame_state(j.frames[1], q, v);
+        let rows = j.rows(&f0, &f1, t, &self.inputs);
+        (f0, f1, rows)
+    }
+
+    /// Constraint residual g(q, t).
+    pub fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
+            }
+        }
+    }
+
+    /// Adds J_pᵀ w + J_φ c of frame `f` into row `row` of `out`.
+    fn add_row_jacobian(
+        &self,
+        out: &mut JacobianRows,
+        row: usize,
+        f: &FrameState,
+        w: Vector2<f64>,
+        c: f64,
+    ) {
+        if let Some(b) = f.body {
+            let o = self.offsets[b];
+            f.for_each_jacobian(w, c, |k, x| out.add(row, o + k, x));
+        }
+    }
+
+    /// Coordinates of each body in q.
+    pub fn body_ranges(&self) -> Vec<Range<usize>> {
+        self.bodies
+            .iter()
+            .zip(&self.offsets)
+            .map(|(b, &o)| o..o + b.ndof())
+            .collect()
+    }
+
+    /// For each constraint row, the bodies of its joint's two frames.
+    pub fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        let mut rows = vec![[None, None]; self.m];
+        for j in &self.joints {
+            let body = |f: usize| match &self.frames[f] {
+                Frame::World { .. } => None,
+                Frame::OnBody { body, .. } => Some(*body),
+            };
+            let bodies = [body(j.frames[0]), body(j.frames[1])];
+            let count = Joint::rows_count(j.kind, j.drive.as_ref());
+            rows[j.row..j.row + count].fill(bodies);
+        }
+        rows
+    }
+
+    /// Constraint Jacobian G = ∂g/∂q by rows, overwritten.
+    pub fn jacobian_rows(&self, q: &DVector<f64>, t: f64, g: &mut JacobianRows) {
+        g.fill_zero();
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                self.add_row_jacobian(g, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(g, j.row + k, &f1, r.w1, r.c1);
+            }
+        }
+    }
+
+    /// Constraint residual g(q, t) and Jacobian G by rows (overwritten) in one pass over the
+    /// joints.
+    pub fn constraints_and_rows(
+        &self,
+        q: &DVector<f64>,
+        t: f64,
+        g: &mut DVector<f64>,
+        gm: &mut JacobianRows,
+    ) {
+        gm.fill_zero();
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
+                self.add_row_jacobian(gm, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(gm, j.row + k, &f1, r.w1, r.c1);
+            }
+        }
+    }
+
+    /// Acceleration bias: d²g/dt² = G q'' + bias.
+    pub fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, Some(v), t);
+            for (k, r) in rows.iter().enumerate() {
+                out[j.row + k] = r.bias;
+            }
+        }
+    }
+
+    /// Mass matrix M(q) by body blocks, overwritten.
+    pub fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        m.fill_zero();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let n = b.ndof();
+            b.mass_matrix(self.body_coords(i, q), m.blocks[i].view_mut((0, 0), (n, n)));
+        }
+    }
+
+    /// Force and torque of load `l` at time t.
+    pub fn load_value(&self, l: &Load, t: f64) -> (Vector2<f64>, f64) {
+        if let Some(s) = &l.scale {
+            let k = s.eval(t, &self.inputs).0;
+            return (l.force * k, l.torque * k);
+        }
+        match l.inputs {
+            Some(s) => (
+                Vector2::new(self.input_at(s, t), self.input_at(s + 1, t)),
+                self.input_at(s + 2, t),
+            ),
+            None => (l.force, l.torque),
+        }
+    }
+
+    fn input_at(&self, slot: usize, t: f64) -> f64 {
+        let u = self.inputs[slot];
+        let dt = t - u.t0;
+        u.value + u.der1 * dt + 0.5 * u.der2 * dt * dt
+    }
+
+    /// Subtracts the generalized force J_pᵀ w + J_φ c of frame `f` from the residual.
+    fn add_generalized_force(&self, r: &mut DVector<f64>, f: &FrameState, w: Vector2<f64>, c: f64) {
+        if let Some(b) = f.body {
+            let o = self.offsets[b];
+            f.for_each_jacobian(w, c, |k, x| r[o + k] -= x);
+        }
+    }
+
+    /// Residual r(q, q', q'', t) without the reactions: inertia + internal - applied, overwritten.
+    pub fn body_residual(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        t: f64,
+        r: &mut DVector<f64>,
+    ) {
+        r.fill(0.0);
+        for (i, b) in self.bodies.iter().enumerate() {
+            let o = self.offsets[i];
+            let n = b.ndof();
+            b.residual(
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
+                self.gravity,
+                &mut r.as_mut_slice()[o..o + n],
+            );
+        }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, None);
+            let (force, torque) = self.load_value(l, t);
+            self.add_generalized_force(r, &fs, force, torque);
+        }
+        for j in &self.joints {
+            if let Some(effort) = j.effort(t, &self.inputs) {
+                let f0 = self.frame_state(j.frames[0], q, Some(v));
+                let f1 = self.frame_state(j.frames[1], q, Some(v));
+                let c = j.coordinate(&f0, &f1);
+                self.add_generalized_force(r, &f0, c.w0 * effort, c.c0 * effort);
+                self.add_generalized_force(r, &f1, c.w1 * effort, c.c1 * effort);
+            }
+        }
+    }
+
+    fn add_force_tangent(
+        &self,
+        kt: &mut BlockDiagonal,
+        frame: usize,
+        q: &DVector<f64>,
+        force: Vector2<f64>,
+    ) {
+        if let Frame::OnBody { body, map } = &self.frames[frame] {
+            let b = &self.bodies[*body];
+            let n = b.ndof();
+            frame::add_force_tangent(
+                b,
+                map,
+                self.body_coords(*body, q),
+                force,
+                kt.blocks[*body].view_mut((0, 0), (n, n)),
+            );
+        }
+    }
+
+    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten. The terms
+    /// from the rotation of a prismatic axis and of effort drives are left out (Newton
+    /// converges without them); a reaction or load only acts on its own body's block.
+    pub fn tangent_blocks(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        lambda: &DVector<f64>,
+        t: f64,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
+    ) {
+        kt.fill_zero();
+        ct.fill_zero();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let n = b.ndof();
+            b.tangents(
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
+                self.gravity,
+                kt.blocks[i].view_mut((0, 0), (n, n)),
+                ct.blocks[i].view_mut((0, 0), (n, n)),
+            );
+        }
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                if let Some(d) = r.force_dir {
+                    let l = lambda[j.row + k];
+                    self.add_force_tangent(kt, j.frames[1], q, d * l);
+                    self.add_force_tangent(kt, j.frames[0], q, -d * l);
+                }
+            }
+        }
+        for l in &self.loads {
+            let (force, _) = self.load_value(l, t);
+            self.add_force_tangent(kt, l.frame, q, -force);
+        }
+    }
+
+    /// Kinetic, strain and gravity energy.
+    pub fn energy(&self, q: &DVector<f64>, v: &DVector<f64>) -> Energy {
+        let mut e = Energy::default();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let z = self.body_coords(i, q);
+            e.kinetic += b.kinetic_energy(z, self.body_coords(i, v));
+            e.strain += b.strain_energy(z);
+            e.potential += b.gravity_energy(z, self.gravity);
+        }
+        e
+    }
+
+    /// Evaluations of each optional term, summed over the bodies.
+    pub fn term_counts(&self) -> TermCounts {
+        let total = TermCounts::default();
+        for b in &self.bodies {
+            total.add(b.counts());
+        }
+        total
+    }
+
+    /// Names of the joints whose equations are in the given constraint rows.
+    pub fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for &r in rows {
+            if let Some(j) = self.joints.iter().rev().find(|j| j.row <= r) {
+                if !names.contains(&j.name) {
+                    names.push(j.name.clone());
+                }
+            }
+        }
+        names
+    }
+
+    /// Times where a drive law jumps, for the integrator to land on.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self
+            .joints
+            .iter()
+            .filter_map(|j| j.drive.as_ref())
+            .map(|d| &d.law)
+            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
+            .flat_map(TimeLaw::breakpoints)
+            .collect();
+        b.sort_by(|x, y| x.total_cmp(y));
+        b.dedup();
+        b
+    }
+
+    /// Joint coordinate (rad or m) and its rate.
+    pub fn joint_coordinate(&self, j: usize, q: &DVector<f64>, v: &DVector<f64>) -> (f64, f64) {
+        let jt = &self.joints[j];
+        let f0 = self.frame_state(jt.frames[0], q, Some(v));
+        let f1 = self.frame_state(jt.frames[1], q, Some(v));
+        let c = jt.coordinate(&f0, &f1);
+        let body_rate = |f: &FrameState, w, c| {
+            f.body
+                .map_or(0.0, |b| f.jacobian_dot(w, c, self.body_coords(b, v)))
+        };
+        (c.g, body_rate(&f0, c.w0, c.c0) + body_rate(&f1, c.w1, c.c1))
+    }
+
+    /// Torque (revolute) or force (prismatic) that the joint's drive applies across the joint:
+    /// the effort law, or the reaction of a motion drive (-λ of its row); 0 without a drive.
+    pub fn joint_effort(&self, j: usize, lambda: &DVector<f64>, t: f64) -> f64 {
+        let jt = &self.joints[j];
+        match jt.drive.as_ref().map(|d| d.kind) {
+            Some(DriveKind::Effort) => jt.effort(t, &self.inputs).unwrap_or(0.0),
+            Some(DriveKind::Motion) => {
+                let row = jt.row + Joint::rows_count(jt.kind, jt.drive.as_ref()) - 1;
+                -lambda[row]
+            }
+            None => 0.0,
+        }
+    }
+
+    /// Power of drives and loads (W): Σ effort × joint rate + Σ F·ṗ + τ φ̇.
+    pub fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
+        let mut p = 0.0;
+        for (j, jt) in self.joints.iter().enumerate() {
+            if jt.drive.is_some() {
+                p += self.joint_effort(j, lambda, t) * self.joint_coordinate(j, q, v).1;
+            }
+        }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, Some(v));
+            let (force, torque) = self.load_value(l, t);
+            p += force.dot(&fs.pd) + torque * fs.phid;
+        }
+        p
+    }
+
+    /// ∂Q/∂u of input `slot`: the generalized force of one unit of that input at (q, q', t),
+    /// from the input loads and effort drives that read it (Q is linear in the inputs), as
+    /// (coordinate, value) pairs; entries of one coordinate add.
+    pub fn input_force(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        t: f64,
+        slot: usize,
+    ) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        let mut push = |f: &FrameState, w: Vector2<f64>, c: f64| {
+            if let Some(b) = f.body {
+                let o = self.offsets[b];
+                f.for_each_jacobian(w, c, |k, x| out.push((o + k, x)));
+            }
+        };
+        for l in &self.loads {
+            let Some(s) = l.inputs.filter(|s| (*s..*s + 3).contains(&slot)) else {
+                continue;
+            };
+            if l.scale.is_some() {
+                continue; // a scaled load does not read its inputs
+            }
+            let fs = self.frame_state(l.frame, q, None);
+            let (w, c) = match slot - s {
+                0 => (Vector2::x(), 0.0),
+                1 => (Vector2::y(), 0.0),
+                _ => (Vector2::zeros(), 1.0),
+            };
+            push(&fs, w, c);
+        }
+        let unit = InputValue::unit(self.inputs.len(), slot, t);
+        for j in &self.joints {
+            let reads = j.drive.as_ref().is_some_and(|d| {
+                d.kind == DriveKind::Effort && d.law.law == super::law::Law::Input(slot)
+            });
+            // the effort per unit input: 1, or 0 past the law's `until`
+            let Some(e) = j.effort(t, &unit).filter(|_| reads) else {
+                continue;
+            };
+            let f0 = self.frame_state(j.frames[0], q, Some(v));
+            let f1 = self.frame_state(j.frames[1], q, Some(v));
+            let c = j.coordinate(&f0, &f1);
+            push(&f0, c.w0 * e, c.c0 * e);
+            push(&f1, c.w1 * e, c.c1 * e);
+        }
+        out
+    }
+
+    /// Index of the scene joint `name` in `joints`.
+    /// The body a frame lies on (`None` for the world).
+    pub fn frame_body(&self, frame: usize) -> Option<usize> {
+        match &self.frames[frame] {
+            Frame::OnBody { body, .. } => Some(*body),
+            Frame::World { .. } => None,
+        }
+    }
+
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// World position and angle of the tip (flange b) of beam group `g`, and of its root frame.
+    pub fn beam_tip(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        self.flange(self.beams[g].bodies.end - 1, true, q)
+    }
+
+    /// World position and angle of flange b (`tip`) or a of `body`, a beam or a rigid bar.
+    fn flange(&self, body: usize, tip: bool, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        let z = self.body_coords(body, q);
+        match &self.bodies[body] {
+            Body::Beam(b) => b.point(if tip { &b.flange_b } else { &b.flange_a }, z),
+            Body::Rigid(r) => r_point(r, if tip { "b" } else { "a" }, z),
+        }
+    }
+
+    /// World position and angle of the root (flange a) of beam group `g`: the tangent there.
+    pub fn beam_root(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, f64) {
+        self.flange(self.beams[g].bodies.start, false, q)
+    }
+
+    /// Transverse displacement of the tip (flange b) of beam group `g` from the tangent at its
+    /// root (flange a), whatever the frame: for a tangent frame that tangent is the frame's
+    /// axis; a pinned frame's axis is the chord, from which the tip does not deflect.
+    pub fn beam_tip_deflection(&self, g: usize, q: &DVector<f64>) -> f64 {
+        let (root, phi) = self.beam_root(g, q);
+        let d = self.beam_tip(g, q).0 - root;
+        let (s, c) = phi.sin_cos();
+        c * d.y - s * d.x
+    }
+
+    /// Transverse displacement of a world point from the beam's root axis (or, for a pinned
+    /// frame, from the chord flange a → flange b).
+    pub fn beam_transverse(&self, g: usize, q: &DVector<f64>, p: Vector2<f64>) -> f64 {
+        let (root, axis) = self.beam_axis(g, q);
+        let d = p - root;
+        axis.x * d.y - axis.y * d.x
+    }
+
+    /// The root (flange a) of beam group `g` and the unit world direction its deflections are
+    /// measured from: the root frame's axis, or for a pinned frame the chord to flange b.
+    pub fn beam_axis(&self, g: usize, q: &DVector<f64>) -> (Vector2<f64>, Vector2<f64>) {
+        let grp = &self.beams[g];
+        let z0 = self.body_coords(grp.bodies.start, q);
+        let root = Vector2::new(z0[0], z0[1]);
+        let axis = if grp.pinned {
+            let (tip, _) = self.beam_tip(g, q);
+            let d = tip - root;
+            if d.norm() > 0.0 {
+                d / d.norm()
+            } else {
+                Vector2::x()
+            }
+        } else {
+            let (s, c) = z0[2].sin_cos();
+            Vector2::new(c, s)
+        };
+        (root, axis)
+    }
+
+    /// World position of the beam's mid-span point.
+    pub fn beam_mid(&self, g: usize, q: &DVector<f64>) -> Vector2<f64> {
+        let (body, map) = &self.beams[g].mid;
+        self.bodies[*body].point(map, self.body_coords(*body, q)).0
+    }
+}
+
+fn r_point(r: &RigidBody, frame: &str, z: DVectorView<f64>) -> (Vector2<f64>, f64) {
+    let map = r
+        .frame_map(frame)
+        .unwrap_or_else(|| r.frame_map("origin").expect("origin"));
+    let (ar, _) = rot(z[2]);
+    (Vector2::new(z[0], z[1]) + ar * map.s0, z[2])
+}
+
+impl super::equations::Equations for System {
+    fn n(&self) -> usize {
+        System::n(self)
+    }
+    fn m(&self) -> usize {
+        System::m(self)
+    }
+    fn length_scale(&self) -> f64 {
+        System::length_scale(self)
+    }
+    fn coordinate_kinds(&self) -> Vec<super::equations::CoordinateKind> {
+        use super::equations::CoordinateKind;
+        let mut kinds = vec![CoordinateKind::Length; self.n];
+        for (i, b) in self.bodies.iter().enumerate() {
+            for k in 0..b.ndof() {
+                kinds[self.offsets[i] + k] = CoordinateKind::of(b.is_massless(), b.is_angle(k));
+            }
+        }
+        kinds
+    }
+    fn frame_coordinates(&self) -> Vec<usize> {
+        System::frame_coordinates(self)
+    }
+    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
+        System::initial_coordinates(self, scene)
+    }
+    fn body_ranges(&self) -> Vec<Range<usize>> {
+        System::body_ranges(self)
+    }
+    fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
+        System::row_bodies(self)
+    }
+    fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
+        System::mass_blocks(self, q, m)
+    }
+    fn body_residual(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        t: f64,
+        r: &mut DVector<f64>,
+    ) {
+        System::body_residual(self, q, v, a, t, r)
+    }
+    fn tangent_blocks(
+        &self,
+        q: &DVector<f64>,
+        v: &DVector<f64>,
+        a: &DVector<f64>,
+        lambda: &DVector<f64>,
+        t: f64,
+        kt: &mut BlockDiagonal,
+        ct: &mut BlockDiagonal,
+    ) {
+        System::tangent_blocks(self, q, v, a, lambda, t, kt, ct)
+    }
+    fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
+        System::constraints(self, q, t, g)
+    }
+    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, gm: &mut JacobianRows) {
+        System::jacobian_rows(self, q, t, gm)
+    }
+    fn constraints_and_rows(
+        &self,
+        q: &DVector<f64>,
+        t: f64,
+        g: &mut DVector<f64>,
+        gm: &mut JacobianRows,
+    ) {
+        System::constraints_and_rows(self, q, t, g, gm)
+    }
+    fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
+        System::accel_bias(self, q, v, t, out)
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        System::breakpoints(self)
+    }
+    fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
+        System::joints_of_rows(self, rows)
+    }
+    fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
+        System::power(self, q, v, lambda, t)
+    }
+    fn turning(&self) -> Option<Turning> {
+        Some(System::turning(self))
+    }
+}

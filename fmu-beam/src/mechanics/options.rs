@@ -1,0 +1,20 @@
+//! What a built system computes: the resolved effects (the policy that resolves them from a
+//! scene, `effects = "auto"` among them, is the unit's: `unit::effects`).
+
+use super::beam::planar_beam::BeamOptions;
+
+/// The resolved effects: what the system computes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Effects {
+    pub gravity: bool,
+    /// One entry per scene beam, in scene order.
+    pub beams: Vec<BeamEffects>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamEffects {
+    /// A rigid bar (no deformation coordinates).
+    pub rigid: bool,
+    /// The terms of the flexible beam (ignored when rigid).
+    pub options: BeamOptions,
+}

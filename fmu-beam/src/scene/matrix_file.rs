@@ -1,0 +1,390 @@
+//! A beam whose mass and stiffness come from 12 × 12 matrices in a text file, condensed from
+//! another FE tool (3D paper §6): the file's format, its parser with errors that name file,
+//! line and rule (the beam it gives: `multibody3d::build::matrix_file_beam`).
+//!
+//! # Format
+//! ```text
+//! # comments start with '#', anywhere on a line; blank lines are ignored
+//! length 0.2        # m, distance from node a (x = 0) to node b (x = length)
+//! mass              # then 12 rows of 12 numbers: kg, kg m, kg m^2 by coordinate pair
+//!   ...
+//! stiffness         # then 12 rows of 12 numbers: N/m, N, N m by coordinate pair
+//!   ...
+//! ```
+//! Coordinates, in this order: node a then node b, each [u, v, w, θx, θy, θz] in the beam
+//! frame (x along the axis), translations in m, rotations in rad, right-handed
+//! (θy = −dw/dx, θz = dv/dx for a beam): the element order of
+//! `mechanics::beam::spatial_element`. The matrices are those of the free beam (no support removed).
+//! `length`, `mass` and `stiffness` each appear exactly once, in any order; numbers are Rust
+//! `f64` literals (`1e-3`, `-2.5E+4`) and must be finite.
+//!
+//! # Rules (each refusal names the file, the line and the rule)
+//! - symmetric: |a_ij − a_ji| ≤ [`SYMMETRY_TOLERANCE`] · max |a| (relative to the largest
+//!   entry: FE tools print to 6–16 digits, so a mismatch at that level is rounding);
+//! - positive semi-definite: every eigenvalue (nalgebra's `SymmetricEigen` of the symmetric
+//!   part) ≥ −[`EIGEN_TOLERANCE`] · the largest eigenvalue;
+//! - the stiffness does not resist a rigid motion of the free beam (three translations, three
+//!   small rotations about node a): |K φ| ≤ [`RIGID_TOLERANCE`] · max|K| · max|φ|, else the
+//!   floating frame would see elastic forces from a rigid motion.
+
+use nalgebra::DMatrix;
+use std::path::Path;
+
+/// Matrix size: 2 nodes × 6 coordinates.
+pub const SIZE: usize = 12;
+/// Relative tolerance of the symmetry rule (to the largest entry).
+pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
+/// Relative tolerance of the semi-definiteness rule (to the largest eigenvalue).
+pub const EIGEN_TOLERANCE: f64 = 1e-9;
+/// Relative tolerance of the rigid-motion rule (to the largest entry times the mode's size).
+pub const RIGID_TOLERANCE: f64 = 1e-9;
+
+/// The two matrices and the length of a matrix file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatrixFile {
+    /// Distance between the two nodes (m).
+    pub length: f64,
+    pub mass: DMatrix<f64>,
+    pub stiffness: DMatrix<f64>,
+}
+
+/// Why a matrix file was refused. Row and column fields are 0-based; messages print them
+/// 1-based, as a reader counts.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MatrixFileError {
+    #[error("{file}: cannot read the matrix file: {message}")]
+    Io { file: String, message: String },
+    #[error("{file}:{line}: {rule}")]
+    Syntax {
+        file: String,
+        line: usize,
+        rule: String,
+    },
+    #[error("{file}: {rule}")]
+    Incomplete { file: String, rule: String },
+    #[error(
+        "{file}:{line}: the {block} matrix must be symmetric: entry (row {r}, column {c}) = \
+         {a:e} but (row {c}, column {r}) = {b:e}, apart by more than {tolerance:e} × the largest \
+         entry {largest:e}",
+        r = row + 1,
+        c = col + 1
+    )]
+    NotSymmetric {
+        file: String,
+        line: usize,
+        block: &'static str,
+        row: usize,
+        col: usize,
+        a: f64,
+        b: f64,
+        largest: f64,
+        tolerance: f64,
+    },
+    #[error(
+        "{file}:{line}: the {block} matrix must be positive semi-definite: eigenvalue \
+         {eigenvalue:e} is below −{tolerance:e} × the largest eigenvalue {largest:e}"
+    )]
+    NotPositiveSemiDefinite {
+        file: String,
+        line: usize,
+        block: &'static str,
+        eigenvalue: f64,
+        largest: f64,
+        tolerance: f64,
+    },
+    #[error(
+        "{file}:{line}: the stiffness matrix must not resist a rigid motion of the free beam: \
+         the {motion} gives forces up to {force:e}, above {limit:e} ({tolerance:e} × largest \
+         entry × mode size)"
+    )]
+    RigidMotionStrained {
+        file: String,
+        line: usize,
+        motion: &'static str,
+        force: f64,
+        limit: f64,
+        tolerance: f64,
+    },
+}
+
+/// A block being read: name, header line, rows with their line numbers.
+struct Block {
+    name: &'static str,
+    header: usize,
+    rows: Vec<(usize, Vec<f64>)>,
+}
+
+/// Parses and checks the text of a matrix file; `file` names it in errors.
+pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
+    let syntax = |line: usize, rule: String| MatrixFileError::Syntax {
+        file: file.to_string(),
+        line,
+        rule,
+    };
+    let mut length: Option<(usize, f64)> = None;
+    let mut done: Vec<Block> = Vec::new();
+    let mut open: Option<Block> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let content = raw.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        let mut words = content.split_whitespace();
+        let first = words.next().unwrap_or("");
+        let keyword = match first {
+            "mass" => Some("mass"),
+            "stiffness" => Some("stiffness"),
+            "length" => Some("length"),
+            _ => None,
+        };
+        if let Some(block) = open.as_mut() {
+            if keyword.is_some() {
+                return Err(syntax(
+                    line,
+                    format!(
+                        "the {} block (line {}) has {} rows before `{first}`; it needs 12 rows \
+                         of 12 numbers",
+                        block.name,
+                        block.header,
+                        block.rows.len()
+                    ),
+                ));
+            }
+            let mut row = Vec::with_capacity(SIZE);
+            for token in content.split_whitespace() {
+                let x: f64 = token.parse().map_err(|_| {
+                    syntax(
+                        line,
+                        format!("`{token}` in the {} block is not a number", block.name),
+                    )
+                })?;
+                if !x.is_finite() {
+                    return Err(syntax(
+                        line,
+                        format!("`{token}` in the {} block is not finite", block.name),
+                    ));
+                }
+                row.push(x);
+            }
+            if row.len() != SIZE {
+                return Err(syntax(
+                    line,
+                    format!(
+                        "row {} of the {} block needs 12 numbers, found {}",
+                        block.rows.len() + 1,
+                        block.name,
+                        row.len()
+                    ),
+                ));
+            }
+            block.rows.push((line, row));
+            if block.rows.len() == SIZE {
+                done.push(open.take().unwrap());
+            }
+            continue;
+        }
+        match keyword {
+            Some("length") => {
+                if let Some((first_line, _)) = length {
+                    return Err(syntax(
+                        line,
+                        format!("`length` given more than once (first on line {first_line})"),
+                    ));
+                }
+                let value = words.next();
+                let x = value.and_then(|v| v.parse::<f64>().ok());
+                match (x, words.next()) {
+                    (Some(x), None) if x.is_finite() && x > 0.0 => length = Some((line, x)),
+                    _ => {
+                        return Err(syntax(
+                            line,
+                            format!(
+                                "`length` needs one positive finite number (m), found `{}`",
+                                content["length".len()..].trim()
+                            ),
+                        ))
+                    }
+                }
+            }
+            Some(name) => {
+                if let Some(prev) = done.iter().find(|b| b.name == name) {
+                    return Err(syntax(
+                        line,
+                        format!(
+                            "the {name} block is given more than once (first on line {})",
+                            prev.header
+                        ),
+                    ));
+                }
+                if words.next().is_some() {
+                    return Err(syntax(
+                        line,
+                        format!("`{name}` stands alone on its line; its 12 rows follow"),
+                    ));
+                }
+                open = Some(Block {
+                    name,
+                    header: line,
+                    rows: Vec::new(),
+                });
+            }
+            None => {
+                return Err(syntax(
+                    line,
+                    format!("unknown keyword `{first}`: expected `length`, `mass` or `stiffness`"),
+                ))
+            }
+        }
+    }
+    let incomplete = |rule: String| MatrixFileError::Incomplete {
+        file: file.to_string(),
+        rule,
+    };
+    if let Some(block) = open {
+        return Err(incomplete(format!(
+            "the {} block (line {}) ends after {} rows; it needs 12 rows of 12 numbers",
+            block.name,
+            block.header,
+            block.rows.len()
+        )));
+    }
+    let Some((_, length)) = length else {
+        return Err(incomplete("`length` is missing".into()));
+    };
+    let take = |name: &str| {
+        done.iter()
+            .find(|b| b.name == name)
+            .ok_or_else(|| incomplete(format!("the {name} block is missing")))
+    };
+    let (mb, kb) = (take("mass")?, take("stiffness")?);
+    for b in [mb, kb] {
+        check_symmetric_psd(b, file)?;
+    }
+    let to_matrix = |b: &Block| DMatrix::from_fn(SIZE, SIZE, |i, j| b.rows[i].1[j]);
+    let out = MatrixFile {
+        length,
+        mass: to_matrix(mb),
+        stiffness: to_matrix(kb),
+    };
+    check_rigid_motion(&out.stiffness, length, kb.header, file)?;
+    Ok(out)
+}
+
+fn check_symmetric_psd(b: &Block, file: &str) -> Result<(), MatrixFileError> {
+    let m = DMatrix::from_fn(SIZE, SIZE, |i, j| b.rows[i].1[j]);
+    let largest = m.amax();
+    for i in 0..SIZE {
+        for j in i + 1..SIZE {
+            if (m[(i, j)] - m[(j, i)]).abs() > SYMMETRY_TOLERANCE * largest {
+                return Err(MatrixFileError::NotSymmetric {
+                    file: file.to_string(),
+                    line: b.rows[i].0,
+                    block: b.name,
+                    row: i,
+                    col: j,
+                    a: m[(i, j)],
+                    b: m[(j, i)],
+                    largest,
+                    tolerance: SYMMETRY_TOLERANCE,
+                });
+            }
+        }
+    }
+    let sym = (&m + m.transpose()) * 0.5;
+    let eig = sym.symmetric_eigen().eigenvalues;
+    let (min, max) = (eig.min(), eig.max());
+    if min < -EIGEN_TOLERANCE * max.max(0.0) || max <= 0.0 && min < 0.0 {
+        return Err(MatrixFileError::NotPositiveSemiDefinite {
+            file: file.to_string(),
+            line: b.header,
+            block: b.name,
+            eigenvalue: min,
+            largest: max,
+            tolerance: EIGEN_TOLERANCE,
+        });
+    }
+    Ok(())
+}
+
+/// Nodal rigid modes of a free two-node beam: translations along x, y, z and small rotations
+/// about x, y, z through node a.
+fn rigid_modes(length: f64) -> [(&'static str, [f64; SIZE]); 6] {
+    let mut modes = [
+        ("translation along x", [0.0; SIZE]),
+        ("translation along y", [0.0; SIZE]),
+        ("translation along z", [0.0; SIZE]),
+        ("rotation about x", [0.0; SIZE]),
+        ("rotation about y", [0.0; SIZE]),
+        ("rotation about z", [0.0; SIZE]),
+    ];
+    for node in 0..2 {
+        let o = 6 * node;
+        let x = length * node as f64;
+        for k in 0..6 {
+            modes[k].1[o + k] = 1.0;
+        }
+        modes[4].1[o + 2] = -x; // w = −x θy
+        modes[5].1[o + 1] = x; // v = x θz
+    }
+    modes
+}
+
+fn check_rigid_motion(
+    k: &DMatrix<f64>,
+    length: f64,
+    line: usize,
+    file: &str,
+) -> Result<(), MatrixFileError> {
+    for (motion, phi) in rigid_modes(length) {
+        let size = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let limit = RIGID_TOLERANCE * k.amax() * size;
+        let force = (0..SIZE)
+            .map(|i| (0..SIZE).map(|j| k[(i, j)] * phi[j]).sum::<f64>().abs())
+            .fold(0.0, f64::max);
+        if force > limit {
+            return Err(MatrixFileError::RigidMotionStrained {
+                file: file.to_string(),
+                line,
+                motion,
+                force,
+                limit,
+                tolerance: RIGID_TOLERANCE,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl MatrixFile {
+    /// Reads and checks a matrix file.
+    pub fn load(path: &Path) -> Result<MatrixFile, MatrixFileError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| MatrixFileError::Io {
+            file: file.clone(),
+            message: e.to_string(),
+        })?;
+        parse(&text, &file)
+    }
+
+    /// The file's text (numbers round-trip exactly), with a first comment line.
+    pub fn to_text(&self, comment: &str) -> String {
+        let mut s = format!(
+            "# {comment}\n# coordinates per node: u v w θx θy θz (m, rad); node a at x = 0, \
+             node b at x = length\nlength {}\n",
+            self.length
+        );
+        for (name, m, units) in [
+            ("mass", &self.mass, "kg, kg m, kg m^2"),
+            ("stiffness", &self.stiffness, "N/m, N, N m"),
+        ] {
+            s.push_str(&format!("{name}  # {units}\n"));
+            for i in 0..SIZE {
+                let row: Vec<String> = (0..SIZE).map(|j| format!("{:e}", m[(i, j)])).collect();
+                s.push_str(&row.join(" "));
+                s.push('\n');
+            }
+        }
+        s
+    }
+}

@@ -1,0 +1,135 @@
+//! The engine's layers import only downwards (ARCHITECTURE.md, "Layers"): every `crate::x`
+//! path in the code of a module (comments left out) names a module of its own layer or of one
+//! below it. Fails with the file, the line and the two layers.
+
+use std::path::{Path, PathBuf};
+
+/// The layers from the bottom up; a top-level module belongs to one of them.
+const LAYERS: [(&str, &[&str]); 6] = [
+    ("scene format", &["scene"]),
+    ("errors", &["error"]),
+    ("mechanics", &["mechanics"]),
+    ("integrator", &["integrator"]),
+    ("unit", &["unit"]),
+    ("fmi2", &["fmi2"]),
+];
+
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|(_, ms)| ms.contains(&module))
+}
+
+fn src() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).expect("src is readable") {
+        let p = e.expect("entry").path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The top-level module a file of `src/` belongs to (`None` for lib.rs, the crate root).
+fn module_of(file: &Path) -> Option<String> {
+    let rel = file.strip_prefix(src()).expect("below src");
+    let first = rel.components().next()?.as_os_str().to_str()?.to_string();
+    match first.strip_suffix(".rs") {
+        Some("lib") => None,
+        Some(m) => Some(m.to_string()),
+        None => Some(first),
+    }
+}
+
+/// The modules a line of code names through `crate::` (`crate::a::b`, `crate::{a, b::c}`).
+fn crate_paths(code: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = code;
+    while let Some(i) = rest.find("crate::") {
+        let before = rest[..i].chars().last();
+        rest = &rest[i + "crate::".len()..];
+        if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+            continue; // `my_crate::`, not this crate
+        }
+        let ident = |s: &str| -> String {
+            s.trim_start()
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect()
+        };
+        if let Some(group) = rest.strip_prefix('{') {
+            let end = group.find('}').unwrap_or(group.len());
+            out.extend(group[..end].split(',').map(ident).filter(|s| !s.is_empty()));
+        } else {
+            out.push(ident(rest));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_module_imports_only_from_its_layer_or_below() {
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    files.sort();
+    let mut upward = Vec::new();
+    let mut checked = 0;
+    for file in &files {
+        let Some(module) = module_of(file) else {
+            continue;
+        };
+        let own = layer_of(&module).unwrap_or_else(|| {
+            panic!(
+                "{}: top-level module `{module}` is in no layer (add it to LAYERS and to \
+                 ARCHITECTURE.md)",
+                file.display()
+            )
+        });
+        let text = std::fs::read_to_string(file).expect("readable");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for target in crate_paths(code) {
+                checked += 1;
+                let Some(to) = layer_of(&target) else {
+                    continue; // a crate-root item (re-export), not a layer
+                };
+                if to > own {
+                    upward.push(format!(
+                        "{}:{}: {} ({}) imports `crate::{target}` ({})",
+                        file.strip_prefix(src()).unwrap().display(),
+                        n + 1,
+                        module,
+                        LAYERS[own].0,
+                        LAYERS[to].0
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        checked > 100,
+        "only {checked} crate paths found: is the scan broken?"
+    );
+    assert!(
+        upward.is_empty(),
+        "imports that climb a layer:\n{}",
+        upward.join("\n")
+    );
+}
+
+#[test]
+fn the_scan_sees_paths_groups_and_skips_other_crates() {
+    assert_eq!(crate_paths("use crate::unit::engine::Engine;"), ["unit"]);
+    assert_eq!(
+        crate_paths("use crate::{scene::Scene, mechanics};"),
+        ["scene", "mechanics"]
+    );
+    assert_eq!(
+        crate_paths("x = my_crate::unit::f() + crate::scene::g()"),
+        ["scene"]
+    );
+    assert!(layer_of("unit") > layer_of("integrator"));
+}
