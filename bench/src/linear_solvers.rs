@@ -13,9 +13,9 @@ use fmu_beam::integrator::{
     initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
     Stepper,
 };
-use fmu_beam::mechanics::multibody::Equations;
+use fmu_beam::mechanics::Equations;
 use fmu_beam::mechanics::Mechanics;
-use fmu_beam::unit::effects::resolve;
+use fmu_beam::resolve_effects as resolve;
 use fmu_beam::{EngineError, Scene};
 use nalgebra::DVector;
 use std::fmt::Write as _;

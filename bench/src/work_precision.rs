@@ -3,7 +3,7 @@
 //! parts, modal truncation, geometric stiffening) at every integrator setting (error control at
 //! a tolerance, or a fixed step), the error of the case's outputs against one reference per
 //! case ([`cases::Reference`]: a closed form, or an untimed run of a finer formulation) versus
-//! the CPU time; then, for chosen models, each effect of [`fmu_beam::unit::effects::EFFECTS`]
+//! the CPU time; then, for chosen models, each effect of [`fmu_beam::EFFECTS`]
 //! switched off in turn, and `effects = "auto"`. Runs the engine directly (no FMI layer),
 //! `repeats` times per point, and reports the CPU time of the thread (the scheduler's account
 //! in /proc; wall time where Linux does not offer it) as median / min / max. [`report`] writes
@@ -19,7 +19,7 @@ pub mod spatial;
 use crate::error::BenchError;
 use cases::{Case, Formulation, Reference};
 use fmu_beam::scene::EffectsSpec;
-use fmu_beam::unit::effects::{resolve, EFFECTS};
+use fmu_beam::{resolve_effects as resolve, EFFECTS};
 use fmu_beam::{Engine, EngineError, Scene};
 use std::path::Path;
 use std::time::Instant;
@@ -614,8 +614,8 @@ fn blank(
 /// no beam of the full model has it (geometric stiffening not asked for).
 fn zero_here(
     effect: &str,
-    full: &fmu_beam::unit::effects::Resolution,
-    auto: &fmu_beam::unit::effects::Resolution,
+    full: &fmu_beam::Resolution,
+    auto: &fmu_beam::Resolution,
 ) -> Option<String> {
     let structural = ["gravity", "quadratic_velocity", "rayleigh_damping"];
     if effect == "geometric_stiffening" {
@@ -643,10 +643,7 @@ fn zero_here(
 }
 
 /// What `auto` resolved differently from `all`.
-fn auto_differs(
-    full: &fmu_beam::unit::effects::Resolution,
-    auto: &fmu_beam::unit::effects::Resolution,
-) -> String {
+fn auto_differs(full: &fmu_beam::Resolution, auto: &fmu_beam::Resolution) -> String {
     let diff: Vec<String> =
         auto.decisions
             .iter()

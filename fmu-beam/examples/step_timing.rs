@@ -6,7 +6,7 @@
 //! `--compare` prints the largest difference of each output against such files; `--only NAME`
 //! runs the scenes whose file name contains NAME.
 
-use fmu_beam::unit::variables::{Causality, VarType};
+use fmu_beam::{Causality, VarType};
 use fmu_beam::{Engine, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

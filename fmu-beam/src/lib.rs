@@ -2,19 +2,38 @@
 //! generalized-α) and its FMI 2.0 co-simulation ABI.
 //!
 //! Five layers, each importing only from those below it (`tests/layers.rs` checks it):
-//! 1. [`scene`]: the file format (parsing, validation, the rule table); [`error`] beside it;
+//! 1. [`scene`]: the file format (parsing, validation, the rule table); `error` beside it;
 //! 2. [`mechanics`]: beam sections and elements, planar and spatial systems, joints, equations;
 //! 3. [`integrator`]: generalized-α, Newton, the iteration matrix, the state codec;
-//! 4. [`unit`]: one FMU instance, safe ([`Engine`]), its variables, interface, effects policy;
+//! 4. `unit`: one FMU instance, safe ([`Engine`]), its variables, interface, effects policy;
 //! 5. `fmi2`: the C ABI, the only unsafe code.
+//!
+//! The public API is chosen here: a scene and its unit ([`Scene`], [`Engine`], the variable
+//! table, the effects it resolves), and, for those who assemble systems without a scene (the
+//! benchmarks), the curated [`mechanics`] and [`integrator`] modules. Everything else is
+//! private to the crate.
 
-pub mod error;
-pub mod fmi2;
+mod error;
+mod fmi2;
 pub mod integrator;
 pub mod mechanics;
 pub mod scene;
-pub mod unit;
+#[cfg(test)]
+mod tests;
+mod unit;
+/// The crate by its own name, for `tests/common`, which the in-crate tests share.
+#[cfg(test)]
+extern crate self as fmu_beam;
 
 pub use error::EngineError;
-pub use scene::Scene;
+pub use fmi2::logger::LOG_CATEGORIES;
+/// The C types of the FMI 2.0 headers, shared by the unit's exports and a master's binding.
+pub use fmi2::types as fmi2_types;
+pub use scene::{Scene, SceneError};
+pub use unit::effects::{resolve as resolve_effects, Decision, Resolution, EFFECTS};
 pub use unit::engine::Engine;
+pub use unit::interface::explain as explain_feedthrough;
+pub use unit::modes::natural_frequencies;
+pub use unit::variables::{
+    Binding, Causality, Initial, UnitDef, VarType, Variable, VariableTable, UNITS,
+};

@@ -1,7 +1,7 @@
 //! Case C1 (planar paper §5.1, CASES.md): natural frequencies of the clamped aluminium beam
 //! against the FE column (N = 10) and the exact values (N = 40), and the simulated response.
 
-use fmu_beam::unit::modes::natural_frequencies;
+use fmu_beam::natural_frequencies;
 use fmu_beam::Scene;
 
 fn c1(elements: usize) -> Scene {
@@ -119,7 +119,7 @@ fn run(scene: Scene, adaptive: bool, tol: f64, max_step: f64, t_end: f64) -> (f6
 /// The exact tip deflection of the (linear, clamped) FE model at time t, by modal superposition:
 /// q(t) = Σ φ_k cos(ω_k t) φ_kᵀ M q0.
 fn exact_fe_tip(scene: &Scene, t: f64) -> f64 {
-    use fmu_beam::mechanics::beam::planar_beam::PlanarBeam;
+    use fmu_beam::mechanics::PlanarBeam;
     let b = PlanarBeam::from_spec(&scene.beams[0]);
     let q0 = b.static_tip_shape(0.01).unwrap();
     let chol = b.mff.clone().cholesky().unwrap();

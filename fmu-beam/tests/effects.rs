@@ -6,10 +6,11 @@ mod common;
 
 use common::{run, scene};
 use fmu_beam::integrator::{initial_state, Settings, Stats, Stepper};
-use fmu_beam::mechanics::multibody::System;
+use fmu_beam::mechanics::Effects;
+use fmu_beam::mechanics::System;
+use fmu_beam::natural_frequencies;
+use fmu_beam::resolve_effects as resolve;
 use fmu_beam::scene::{EffectsSpec, Scene};
-use fmu_beam::unit::effects::{resolve, Effects};
-use fmu_beam::unit::modes::natural_frequencies;
 
 fn with_effects(mut s: Scene, effects: EffectsSpec) -> Scene {
     s.effects = effects;
@@ -330,7 +331,7 @@ fn modal_truncation_converges_to_the_full_model() {
 
 #[test]
 fn the_variables_are_those_of_the_effects_that_are_on() {
-    use fmu_beam::unit::variables::VariableTable;
+    use fmu_beam::VariableTable;
     let names = |s: &Scene| -> Vec<String> {
         VariableTable::build(s)
             .variables

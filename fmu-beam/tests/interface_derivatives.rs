@@ -7,7 +7,7 @@
 mod common;
 
 use common::{scene, vr};
-use fmu_beam::unit::variables::{Binding, Causality, VarType};
+use fmu_beam::{Binding, Causality, VarType};
 use fmu_beam::{Engine, EngineError, Scene};
 
 /// A running engine of `scene`, stepped `steps` times by `h` with every input at `inputs`.

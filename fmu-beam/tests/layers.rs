@@ -5,13 +5,14 @@
 use std::path::{Path, PathBuf};
 
 /// The layers from the bottom up; a top-level module belongs to one of them.
-const LAYERS: [(&str, &[&str]); 6] = [
+const LAYERS: [(&str, &[&str]); 7] = [
     ("scene format", &["scene"]),
     ("errors", &["error"]),
     ("mechanics", &["mechanics"]),
     ("integrator", &["integrator"]),
     ("unit", &["unit"]),
     ("fmi2", &["fmi2"]),
+    ("in-crate tests", &["tests"]),
 ];
 
 fn layer_of(module: &str) -> Option<usize> {

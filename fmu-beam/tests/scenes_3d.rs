@@ -5,8 +5,8 @@
 mod common;
 
 use common::{run, scene, vr};
-use fmu_beam::mechanics::beam::spatial_element;
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
+use fmu_beam::mechanics::SpatialSection;
+use fmu_beam::mechanics::{spatial_element_mass, spatial_element_stiffness};
 use fmu_beam::scene::matrix_file::MatrixFile;
 use fmu_beam::{Engine, Scene};
 use nalgebra::DMatrix;
@@ -18,8 +18,8 @@ const SCENES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes");
 fn c6_element_text() -> String {
     let s = SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7);
     let (rho, e, g, l) = (7800.0, 210e9, 8.077e10, 0.2);
-    let m = spatial_element::mass(rho * s.area, rho * s.polar_moment, l);
-    let k = spatial_element::stiffness(e * s.area, g * s.torsion_constant, e * s.iy, e * s.iz, l);
+    let m = spatial_element_mass(rho * s.area, rho * s.polar_moment, l);
+    let k = spatial_element_stiffness(e * s.area, g * s.torsion_constant, e * s.iy, e * s.iz, l);
     let to = |a: [[f64; 12]; 12]| DMatrix::from_fn(12, 12, |i, j| a[i][j]);
     MatrixFile {
         length: l,
@@ -311,7 +311,7 @@ fn the_canonical_text_of_a_3d_scene_round_trips() {
 #[test]
 fn the_3d_pendulum_modes_match_beam_theory() {
     // the elastic modes (the free swing about the hinge is a zero frequency)
-    let f: Vec<f64> = fmu_beam::unit::modes::natural_frequencies(&scene("pendulum_3d.toml"))
+    let f: Vec<f64> = fmu_beam::natural_frequencies(&scene("pendulum_3d.toml"))
         .expect("modes")
         .into_iter()
         .filter(|&x| x > 1.0)
@@ -401,7 +401,7 @@ fn a_3d_cantilever_under_input_loads_deflects_and_twists_as_beam_theory_says() {
 #[test]
 fn effects_of_3d_scenes_say_which_element_runs() {
     let first = |file: &str| {
-        let r = fmu_beam::unit::effects::resolve(&scene(file));
+        let r = fmu_beam::resolve_effects(&scene(file));
         let d = &r.decisions[0];
         (d.effect, d.setting.clone())
     };

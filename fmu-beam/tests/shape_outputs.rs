@@ -1,4 +1,4 @@
-//! The shape outputs (`fmu_beam::unit::shape`): the points of each beam's deformed centre line, the
+//! The shape outputs (`<beam>.shape.*`): the points of each beam's deformed centre line, the
 //! axis its deflections are measured from, the joints' positions and the 3D bodies' rotations,
 //! checked against the unit's other outputs, a closed form and each other; reading them does
 //! not change the run.
@@ -176,7 +176,7 @@ fn c4_shape_points_set_by_the_scene_are_equally_spaced_material_points() {
 fn shape_points_and_the_outputs_list_decide_what_is_offered() {
     let base = scene("spin_up_omega10.toml");
     let offered = |s: &Scene| {
-        fmu_beam::unit::variables::VariableTable::build(s)
+        fmu_beam::VariableTable::build(s)
             .variables
             .iter()
             .filter(|v| v.name.starts_with("beam.shape.") || v.name.starts_with("beam.axis."))

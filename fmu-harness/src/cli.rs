@@ -307,7 +307,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
         }
         Command::Explain { scene } => {
             let scene = fmu_beam::Scene::load(&scene)?;
-            let text = fmu_beam::unit::effects::resolve(&scene).explain(&scene);
+            let text = fmu_beam::resolve_effects(&scene).explain(&scene);
             out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
         Command::Schema { output } => {

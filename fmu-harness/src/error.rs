@@ -54,7 +54,7 @@ pub enum HarnessError {
     Template { message: String },
     #[error(
         "scene `{scene}`: variable `{variable}` has unit `{unit}`, which \
-         fmu_beam::unit::variables::UNITS does not define: the FMU would not validate"
+         fmu_beam::UNITS does not define: the FMU would not validate"
     )]
     UndefinedUnit {
         scene: String,

@@ -2,7 +2,7 @@
 //! linearized natural frequencies, and runs FMI 2.0 co-simulation FMUs (any, not only ours)
 //! through [`slave::Slave`] over the raw binding [`fmi2_binding`] (the crate's only unsafe code).
 //!
-//! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::unit::variables::VariableTable`] →
+//! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::VariableTable`] →
 //! [`model_description::render`] (the template in `modelDescription-templates/`) →
 //! [`guid::guid`] → [`archive::write_fmu`] (deterministic zip, written atomically).
 

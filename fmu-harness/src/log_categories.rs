@@ -1,7 +1,7 @@
 //! The log categories the FMU declares in modelDescription.xml: the engine's own list, so the
 //! XML and the categories fmi2SetDebugLogging accepts can never disagree.
 
-pub use fmu_beam::fmi2::logger::LOG_CATEGORIES;
+pub use fmu_beam::LOG_CATEGORIES;
 
 #[cfg(test)]
 mod tests {

@@ -5,8 +5,8 @@ use crate::error::HarnessError;
 use crate::log_categories::LOG_CATEGORIES;
 use crate::template::{escape_attribute, fill, Fill};
 use fmu_beam::scene::ExperimentSpec;
-use fmu_beam::unit::variables::{Causality, Initial, UnitDef, VarType, Variable, VariableTable};
 use fmu_beam::Scene;
+use fmu_beam::{Causality, Initial, UnitDef, VarType, Variable, VariableTable};
 use quick_xml::events::attributes::Attribute;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 use quick_xml::name::QName;
@@ -177,7 +177,7 @@ pub fn model_variables(table: &VariableTable) -> Result<String, HarnessError> {
 /// Outputs and InitialUnknowns (outputs and calculated parameters).
 ///
 /// Each output lists the inputs it depends on directly (`Variable::dependencies`, from
-/// `fmu_beam::unit::interface::dependencies`): the accelerations of input loads' frames on the force
+/// `VariableTable`'s dependencies): the accelerations of input loads' frames on the force
 /// inputs, an input effort drive's effort on its input, the constraint residual on the motion
 /// inputs; every other output on none (`dependencies=""`). InitialUnknowns never carry it.
 pub fn model_structure(table: &VariableTable) -> Result<String, HarnessError> {

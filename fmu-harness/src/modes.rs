@@ -10,11 +10,9 @@ pub const RIGID_BODY_LIMIT_HZ: f64 = 1e-6;
 /// The elastic natural frequencies (Hz, ascending) of the scene file.
 pub fn elastic_frequencies(scene_path: &Path) -> Result<Vec<f64>, HarnessError> {
     let scene = Scene::load(scene_path)?;
-    let f = fmu_beam::unit::modes::natural_frequencies(&scene).map_err(|source| {
-        HarnessError::Engine {
-            origin: scene_path.display().to_string(),
-            source,
-        }
+    let f = fmu_beam::natural_frequencies(&scene).map_err(|source| HarnessError::Engine {
+        origin: scene_path.display().to_string(),
+        source,
     })?;
     Ok(f.into_iter()
         .filter(|&f| f >= RIGID_BODY_LIMIT_HZ)

@@ -10,8 +10,8 @@ use crate::error::HarnessError;
 use crate::guid::guid;
 use crate::model_description;
 use crate::platform::Platform;
-use fmu_beam::unit::variables::VariableTable;
 use fmu_beam::Scene;
+use fmu_beam::VariableTable;
 use std::path::{Path, PathBuf};
 
 /// File name of the engine cdylib that cargo builds for Linux.
@@ -111,10 +111,10 @@ pub fn contents(
 /// documentation/index.html: the scene's description, its variables (the table that
 /// modelDescription.xml is written from: name, causality, variability, type, unit, start,
 /// meaning; inputs first, then outputs, then parameters), its resolved effects and its direct
-/// feedthrough (`fmu_beam::unit::interface::explain`).
+/// feedthrough (`fmu_beam::explain_feedthrough`).
 fn documentation(scene: &Scene, table: &VariableTable) -> String {
-    let effects = fmu_beam::unit::effects::resolve(scene).explain(scene);
-    let feedthrough = fmu_beam::unit::interface::explain(scene, table);
+    let effects = fmu_beam::resolve_effects(scene).explain(scene);
+    let feedthrough = fmu_beam::explain_feedthrough(scene, table);
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\n{STYLE}</head>\n\
          <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Variables</h2>\n{variables}\
@@ -141,7 +141,7 @@ fn escape(s: &str) -> String {
 /// The variables as an HTML table, one row per variable: what a master's user connects
 /// (inputs, outputs) first, then what they may set (parameters).
 fn variables_html(table: &VariableTable) -> String {
-    use fmu_beam::unit::variables::Causality;
+    use fmu_beam::Causality;
     let mut html = String::from(
         "<p>Units are SI. An input is held over a communication step (or extrapolated from the \
          derivatives a master sets); a tunable parameter may be set between steps, a fixed one \

@@ -38,7 +38,7 @@ fn explain_prints_every_effect_with_its_reason() {
     let rows: Vec<&str> = text
         .lines()
         .filter(|l| {
-            fmu_beam::unit::effects::EFFECTS
+            fmu_beam::EFFECTS
                 .iter()
                 .any(|(e, _)| l.starts_with(&format!("{e} (")))
         })

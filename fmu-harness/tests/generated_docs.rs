@@ -5,8 +5,8 @@
 //! `documentation/index.html` lists each variable of the table that writes its
 //! modelDescription.xml, with its causality, variability, type, unit and meaning.
 
-use fmu_beam::unit::variables::VariableTable;
 use fmu_beam::Scene;
+use fmu_beam::VariableTable;
 use fmu_harness::platform::Platform;
 use fmu_harness::{model_description, package, reference, schema};
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use fmu_beam::unit::variables::{Causality, VariableTable};
+use fmu_beam::{Causality, VariableTable};
 
 #[test]
 fn every_table_variable_appears_exactly_once() {

@@ -6,7 +6,7 @@
 //! - Compound pendulum: I α'' = −m g (L/2) cos α with I = m L²/3; period from rest at the
 //!   horizontal 4K(k)/ω₀, k = sin 45°, ω₀ = √(3g/2L).
 
-use fmu_beam::mechanics::beam::section::Section;
+use fmu_beam::mechanics::Section;
 use fmu_beam::Scene;
 use std::f64::consts::PI;
 

@@ -302,7 +302,7 @@ pub fn markdown(
             let _ = writeln!(
                 s,
                 "### {}: effects switched off in turn ({name}, {setting})\n\n\
-                 Each row lists every effect of `fmu_beam::unit::effects::EFFECTS` but one (`effects = \
+                 Each row lists every effect of `fmu_beam::EFFECTS` but one (`effects = \
                  [...]`); `auto` lets the generator decide. Time / full is the median CPU time \
                  over the full model's; error added is this row's error less the full model's, \
                  both against the case's reference (negative: the omission happens to move the \

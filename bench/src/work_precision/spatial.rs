@@ -16,13 +16,13 @@ use super::{
 };
 use crate::error::BenchError;
 use fmu_beam::integrator::{initial_state, GaState, Settings, Stats, Stepper};
-use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeam, SpatialBeamProps};
-use fmu_beam::mechanics::beam::spatial_element;
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
-use fmu_beam::mechanics::multibody::joint::Drive;
-use fmu_beam::mechanics::multibody::law::{Law, TimeLaw};
-use fmu_beam::mechanics::multibody3d::build::matrix_file_beam;
-use fmu_beam::mechanics::multibody3d::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
+use fmu_beam::mechanics::matrix_file_beam;
+use fmu_beam::mechanics::Drive;
+use fmu_beam::mechanics::SpatialSection;
+use fmu_beam::mechanics::{spatial_element_mass, spatial_element_stiffness};
+use fmu_beam::mechanics::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
+use fmu_beam::mechanics::{InertiaModel, SpatialBeam, SpatialBeamProps};
+use fmu_beam::mechanics::{Law, TimeLaw};
 use fmu_beam::scene::matrix_file::{self, MatrixFile};
 use fmu_beam::scene::{DriveKind, FrameKind};
 use fmu_beam::{EngineError, Scene};
@@ -239,8 +239,8 @@ fn props(length: f64, elements: usize, inertia: InertiaModel, alpha: f64) -> Spa
 /// read back through its parser (the file's checks included).
 fn element_file(length: f64) -> Result<MatrixFile, BenchError> {
     let s = section();
-    let m = spatial_element::mass(RHO * s.area, RHO * s.polar_moment, length);
-    let k = spatial_element::stiffness(
+    let m = spatial_element_mass(RHO * s.area, RHO * s.polar_moment, length);
+    let k = spatial_element_stiffness(
         E * s.area,
         G * s.torsion_constant,
         E * s.iy,
@@ -1043,7 +1043,7 @@ fn variant_table(t: &VariantTable) -> String {
 pub fn markdown(r: &Results) -> String {
     let mut s = format!(
         "## 3D (issue 4): C5, C6 and the fast variants\n\n\
-         The spatial multibody layer (`fmu_beam::mechanics::multibody3d::System3`, quaternion frames, \
+         The spatial multibody layer (`fmu_beam::mechanics::System3`, quaternion frames, \
          finite-difference tangents) through the same generalized-α, timed as above (thread CPU \
          time, median (min–max) of the samples; a run includes building the model). This \
          section took {:.0} s wall time.\n\n",

@@ -1081,7 +1081,7 @@ fn debug_logging_categories() {
         fmi2OK,
         "all categories"
     );
-    let all_categories: Vec<&str> = crate::fmi2::LOG_CATEGORIES
+    let all_categories: Vec<&str> = crate::fmi2::logger::LOG_CATEGORIES
         .iter()
         .map(|(n, _)| *n)
         .collect();

@@ -8,16 +8,14 @@
 #![allow(unsafe_code)]
 #![deny(unsafe_op_in_unsafe_fn)]
 
-pub mod exports;
-pub mod fmu_state;
-pub mod guard;
-pub mod instance;
-pub mod logger;
-pub mod resources;
-pub mod state_machine;
+pub(crate) mod exports;
+pub(crate) mod fmu_state;
+pub(crate) mod guard;
+pub(crate) mod instance;
+pub(crate) mod logger;
+pub(crate) mod resources;
+pub(crate) mod state_machine;
 pub mod types;
-
-pub use logger::LOG_CATEGORIES;
 
 #[cfg(test)]
 mod abi_tests;

@@ -1,17 +1,20 @@
-//! Time integration of M(q) q'' + G(q)ᵀλ = Q(q, q', t), g(q) = 0.
+//! Layer 3, time integration of M(q) q'' + G(q)ᵀλ = Q(q, q', t), g(q) = 0: generalized-α
+//! ([`Stepper`]) with Newton iterations on a factorized iteration matrix, error control, dense
+//! output, consistent (re)starts and the byte codec of its state. Imports the mechanics' [`Equations`](crate::mechanics::Equations)
+//! and the layers below.
 
-pub mod codec;
-pub mod dense_output;
-pub mod generalized_alpha;
-pub mod initial;
-pub mod iteration_matrix;
-pub mod newton;
+pub(crate) mod codec;
+pub(crate) mod dense_output;
+pub(crate) mod generalized_alpha;
+pub(crate) mod initial;
+pub(crate) mod iteration_matrix;
+pub(crate) mod newton;
 
-pub use generalized_alpha::{
-    iteration_scaling, Controller, GaState, MatrixPoint, Memory, SplitReason, Stepper,
-};
+pub use generalized_alpha::{iteration_scaling, GaState, Stepper};
+pub(crate) use generalized_alpha::{Controller, MatrixPoint, Memory, SplitReason};
 pub use initial::initial_state;
-pub use iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
+pub(crate) use iteration_matrix::Scaling;
+pub use iteration_matrix::{IterationMatrix, LinearSolver};
 
 use crate::error::EngineError;
 use crate::scene::Scene;

@@ -1,13 +1,27 @@
 //! Layer 2, the mechanics: beam sections and finite elements (planar and spatial), the planar
 //! and spatial multibody systems with their joints, and the [`Equations`] the integrator solves.
 //! Imports only the scene format and the errors below it.
+//!
+//! Public here: what assembles a system without a scene file (the benchmarks build C5's beam
+//! this way); the element internals stay private to the crate.
 
-pub mod any_system;
-pub mod beam;
-pub mod multibody;
-pub mod multibody3d;
-pub mod options;
+pub(crate) mod any_system;
+pub(crate) mod beam;
+pub(crate) mod multibody;
+pub(crate) mod multibody3d;
+pub(crate) mod options;
 
 pub use any_system::Mechanics;
-pub use multibody::Equations;
+pub use beam::planar_beam::{BeamOptions, PlanarBeam};
+pub use beam::section::Section;
+pub use beam::spatial_beam::{InertiaModel, SpatialBeam, SpatialBeamProps};
+pub use beam::spatial_element::{
+    mass as spatial_element_mass, stiffness as spatial_element_stiffness,
+};
+pub use beam::spatial_section::SpatialSection;
+pub use multibody::joint::Drive;
+pub use multibody::law::{Law, TimeLaw};
+pub use multibody::{Equations, System};
+pub use multibody3d::build::matrix_file_beam;
+pub use multibody3d::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
 pub use options::{BeamEffects, Effects};

@@ -139,14 +139,14 @@ const ONLY_3D: &str = "is for 3D scenes (dimensions = 3)";
 const PLANE: &str =
     "a planar scene lies in the world x–y plane (z = 0); write dimensions = 3 for a 3D scene";
 
-pub const FINITE: Rule = rule(
+pub(crate) const FINITE: Rule = rule(
     "finite",
     &["*"],
     "must be a finite number",
     Any,
     Schema::None,
 );
-pub const POSITIVE: Rule = rule(
+pub(crate) const POSITIVE: Rule = rule(
     "positive",
     &[
         "solver.tolerance",
@@ -174,7 +174,7 @@ pub const POSITIVE: Rule = rule(
     Any,
     Schema::Above(0.0),
 );
-pub const NON_NEGATIVE: Rule = rule(
+pub(crate) const NON_NEGATIVE: Rule = rule(
     "non_negative",
     &[
         "beam[].rayleigh.alpha",
@@ -188,21 +188,21 @@ pub const NON_NEGATIVE: Rule = rule(
     Any,
     Schema::AtLeast(0.0),
 );
-pub const SCENE_NAME: Rule = rule(
+pub(crate) const SCENE_NAME: Rule = rule(
     "name",
     &["name", "beam[].name"],
     IDENTIFIER,
     Any,
     Schema::Identifier(&[]),
 );
-pub const DIMENSIONS: Rule = rule(
+pub(crate) const DIMENSIONS: Rule = rule(
     "dimensions",
     &["dimensions"],
     "must be 2 (planar) or 3 (spatial)",
     Any,
     Schema::OneOfIntegers(&[2, 3]),
 );
-pub const TOLERANCE_BELOW_ONE: Rule = rule(
+pub(crate) const TOLERANCE_BELOW_ONE: Rule = rule(
     "tolerance_below_one",
     &["solver.tolerance"],
     "must be below 1",
@@ -210,140 +210,140 @@ pub const TOLERANCE_BELOW_ONE: Rule = rule(
     Schema::Below(1.0),
 );
 /// Its text quotes [`super::validate::MIN_STEP`] (a test checks it).
-pub const MIN_STEP: Rule = rule(
+pub(crate) const MIN_STEP: Rule = rule(
     "min_step",
     &["solver.max_step"],
     "must be at least 1e-9 s (a smaller step makes no progress)",
     Any,
     Schema::AtLeast(super::validate::MIN_STEP),
 );
-pub const RHO_INF: Rule = rule(
+pub(crate) const RHO_INF: Rule = rule(
     "rho_inf",
     &["solver.rho_inf"],
     "must lie in [0, 1]",
     Any,
     Schema::Within(0.0, 1.0),
 );
-pub const STOP_AFTER_START: Rule = rule(
+pub(crate) const STOP_AFTER_START: Rule = rule(
     "stop_after_start",
     &["experiment.stop_time"],
     "must be after experiment.start_time",
     Any,
     Schema::None,
 );
-pub const A_BEAM: Rule = rule(
+pub(crate) const A_BEAM: Rule = rule(
     "a_beam",
     &["beam"],
     "a scene needs at least one [[beam]]",
     Any,
     Schema::Required(1),
 );
-pub const BEAM_NAMES_UNIQUE: Rule = rule(
+pub(crate) const BEAM_NAMES_UNIQUE: Rule = rule(
     "beam_names_unique",
     &["beam[].name"],
     "beam names must be unique",
     Any,
     Schema::None,
 );
-pub const PART_NAME: Rule = rule(
+pub(crate) const PART_NAME: Rule = rule(
     "part_name",
     &["beam[].name", "body[].name", "joint[].name", "load[].name"],
     "must be an identifier (letters, digits, _; not starting with a digit) other than world, solver, energy",
     Any,
     Schema::Identifier(&RESERVED_NAMES),
 );
-pub const NAMES_UNIQUE: Rule = rule(
+pub(crate) const NAMES_UNIQUE: Rule = rule(
     "names_unique",
     &["beam[].name", "body[].name", "joint[].name", "load[].name"],
     "names of beams, bodies, joints and loads must be unique",
     Any,
     Schema::None,
 );
-pub const JOINT_FRAME: Rule = rule(
+pub(crate) const JOINT_FRAME: Rule = rule(
     "joint_frame",
     &["joint[].frames[]"],
     "must be `world`, `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
     Any,
     Schema::None,
 );
-pub const JOINT_FRAMES_DIFFER: Rule = rule(
+pub(crate) const JOINT_FRAMES_DIFFER: Rule = rule(
     "joint_frames_differ",
     &["joint[].frames"],
     "a joint connects two different frames",
     Any,
     Schema::Unique,
 );
-pub const WELD_NO_DRIVE: Rule = rule(
+pub(crate) const WELD_NO_DRIVE: Rule = rule(
     "weld_no_drive",
     &["joint[].drive"],
     "a weld joint has no motion to drive",
     Any,
     Schema::AbsentWhen("type", "weld"),
 );
-pub const MOTION_CONTINUOUS: Rule = rule(
+pub(crate) const MOTION_CONTINUOUS: Rule = rule(
     "motion_continuous",
     &["joint[].drive.law"],
     "a motion drive needs a law with a continuous start (constant, spin_up, table, input)",
     Any,
     Schema::None,
 );
-pub const LOAD_FRAME: Rule = rule(
+pub(crate) const LOAD_FRAME: Rule = rule(
     "load_frame",
     &["load[].frame"],
     "must be `<beam>.a`, `<beam>.b` or `<body>.<frame>` of this scene",
     Any,
     Schema::None,
 );
-pub const LOAD_ON_BODY: Rule = rule(
+pub(crate) const LOAD_ON_BODY: Rule = rule(
     "load_on_body",
     &["load[].frame"],
     "a load acts on a body",
     Any,
     Schema::NoneOf(&["world"]),
 );
-pub const SCALE_NOT_INPUT: Rule = rule(
+pub(crate) const SCALE_NOT_INPUT: Rule = rule(
     "scale_not_input",
     &["load[].scale"],
     "an input load, or an input law, cannot scale a load (use input = true)",
     Any,
     Schema::None,
 );
-pub const EFFECTS_MODE: Rule = rule(
+pub(crate) const EFFECTS_MODE: Rule = rule(
     "effects_mode",
     &["effects"],
     "must be \"all\", \"auto\" or a list of effects",
     Any,
     Schema::OneOf(&["all", "auto"]),
 );
-pub const EFFECT_KNOWN: Rule = rule(
+pub(crate) const EFFECT_KNOWN: Rule = rule(
     "effect_known",
     &["effects[]"],
     "is not an effect; the effects are gravity, flexibility, axial, quadratic_velocity, geometric_stiffening, rayleigh_damping",
     Any,
     Schema::OneOf(&EFFECT_NAMES),
 );
-pub const EFFECT_ONCE: Rule = rule(
+pub(crate) const EFFECT_ONCE: Rule = rule(
     "effect_once",
     &["effects[]"],
     "is listed twice",
     Any,
     Schema::Unique,
 );
-pub const DEFORMED_NEEDS_FLEXIBILITY: Rule = rule(
+pub(crate) const DEFORMED_NEEDS_FLEXIBILITY: Rule = rule(
     "deformed_needs_flexibility",
     &["beam[].initial.tip_displacement"],
     "needs the effect \"flexibility\" (a rigid beam cannot start deformed)",
     Any,
     Schema::None,
 );
-pub const STIFFENING_NEEDS_AXIAL: Rule = rule(
+pub(crate) const STIFFENING_NEEDS_AXIAL: Rule = rule(
     "stiffening_needs_axial",
     &["effects"],
     "a beam that asks for geometric stiffening needs the effect \"axial\" in the list",
     Any,
     Schema::None,
 );
-pub const AT_LEAST_ONE: Rule = rule(
+pub(crate) const AT_LEAST_ONE: Rule = rule(
     "at_least_one",
     &[
         "beam[].elements",
@@ -354,77 +354,77 @@ pub const AT_LEAST_ONE: Rule = rule(
     Any,
     Schema::AtLeast(1.0),
 );
-pub const ELEMENTS_MAX: Rule = rule(
+pub(crate) const ELEMENTS_MAX: Rule = rule(
     "elements_max",
     &["beam[].elements", "beam[].elements_per_substructure"],
     "must be at most 2000",
     Any,
     Schema::AtMost(2000.0),
 );
-pub const SUBSTRUCTURES_MAX: Rule = rule(
+pub(crate) const SUBSTRUCTURES_MAX: Rule = rule(
     "substructures_max",
     &["beam[].substructures"],
     "must be at most 500",
     Any,
     Schema::AtMost(500.0),
 );
-pub const LAYOUT_MISSING: Rule = rule(
+pub(crate) const LAYOUT_MISSING: Rule = rule(
     "layout_missing",
     &["beam[].elements"],
     "give `elements`, or `substructures` with `elements_per_substructure`",
     Any,
     Schema::BeamLayout,
 );
-pub const LAYOUT_PER_SUBSTRUCTURE: Rule = rule(
+pub(crate) const LAYOUT_PER_SUBSTRUCTURE: Rule = rule(
     "layout_per_substructure",
     &["beam[].elements_per_substructure"],
     "is required with `substructures`",
     Any,
     Schema::BeamLayout,
 );
-pub const LAYOUT_EITHER: Rule = rule(
+pub(crate) const LAYOUT_EITHER: Rule = rule(
     "layout_either",
     &["beam[].elements"],
     "give either `elements` (one frame) or `substructures` with `elements_per_substructure`",
     Any,
     Schema::BeamLayout,
 );
-pub const DEFORMED_SINGLE_FRAME: Rule = rule(
+pub(crate) const DEFORMED_SINGLE_FRAME: Rule = rule(
     "deformed_single_frame",
     &["beam[].initial.tip_displacement"],
     "is only available for single-frame beams (`elements`)",
     Any,
     Schema::None,
 );
-pub const RIGID_PLAIN: Rule = rule(
+pub(crate) const RIGID_PLAIN: Rule = rule(
     "rigid_plain",
     &["beam[].rigid"],
     "a rigid beam has no substructures, stiffening or initial deformation",
     Any,
     Schema::None,
 );
-pub const MODES_RANGE: Rule = rule(
+pub(crate) const MODES_RANGE: Rule = rule(
     "modes_range",
     &["beam[].modes"],
     "must lie between 1 and the deformation coordinates of a frame of a flexible beam (3 per element)",
     Any,
     Schema::AtLeast(1.0),
 );
-pub const SECTION_MISSING: Rule = rule(
+pub(crate) const SECTION_MISSING: Rule = rule(
     "section_missing",
     &["beam[].section"],
     "give `A` and `J`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
     Planar,
     Schema::None,
 );
-pub const SECTION_MISSING_3D: Rule = rule(
+pub(crate) const SECTION_MISSING_3D: Rule = rule(
     "section_missing_3d",
     &["beam[].section"],
     "give `A`, `Iy`, `Iz` and `It`, or a `shape` (rectangle, circle, hollow_rectangle, hollow_circle) with its dimensions",
     Spatial,
     Schema::None,
 );
-pub const SECTION_VALUE_MISSING: Rule = rule(
+pub(crate) const SECTION_VALUE_MISSING: Rule = rule(
     "section_value_missing",
     &[
         "beam[].section.A",
@@ -441,7 +441,7 @@ pub const SECTION_VALUE_MISSING: Rule = rule(
     Any,
     Schema::None,
 );
-pub const SECTION_3D_CONSTANTS: Rule = rule(
+pub(crate) const SECTION_3D_CONSTANTS: Rule = rule(
     "section_3d_constants",
     &[
         "beam[].section.Iy",
@@ -452,14 +452,14 @@ pub const SECTION_3D_CONSTANTS: Rule = rule(
     Planar,
     Schema::Absent,
 );
-pub const SECTION_PLANAR_J: Rule = rule(
+pub(crate) const SECTION_PLANAR_J: Rule = rule(
     "section_planar_j",
     &["beam[].section.J"],
     "is the planar second moment; a 3D section gives Iy, Iz and It",
     Spatial,
     Schema::Absent,
 );
-pub const SHAPE_DIMENSION_UNUSED: Rule = rule(
+pub(crate) const SHAPE_DIMENSION_UNUSED: Rule = rule(
     "shape_dimension_unused",
     &[
         "beam[].section.a",
@@ -471,7 +471,7 @@ pub const SHAPE_DIMENSION_UNUSED: Rule = rule(
     Any,
     Schema::None,
 );
-pub const CONSTANT_FROM_SHAPE: Rule = rule(
+pub(crate) const CONSTANT_FROM_SHAPE: Rule = rule(
     "constant_from_shape",
     &[
         "beam[].section.A",
@@ -484,98 +484,98 @@ pub const CONSTANT_FROM_SHAPE: Rule = rule(
     Any,
     Schema::None,
 );
-pub const NOT_OF_RECTANGLE: Rule = rule(
+pub(crate) const NOT_OF_RECTANGLE: Rule = rule(
     "not_of_rectangle",
     &["beam[].section.d"],
     "is not a dimension of a rectangle",
     Any,
     Schema::None,
 );
-pub const NOT_OF_CIRCLE: Rule = rule(
+pub(crate) const NOT_OF_CIRCLE: Rule = rule(
     "not_of_circle",
     &["beam[].section.a", "beam[].section.b"],
     "is not a dimension of a circle",
     Any,
     Schema::None,
 );
-pub const HOLLOW_ONLY: Rule = rule(
+pub(crate) const HOLLOW_ONLY: Rule = rule(
     "hollow_only",
     &["beam[].section.t"],
     "is for hollow shapes",
     Any,
     Schema::None,
 );
-pub const WALL_OF_RECTANGLE: Rule = rule(
+pub(crate) const WALL_OF_RECTANGLE: Rule = rule(
     "wall_of_rectangle",
     &["beam[].section.t"],
     "must be less than half of min(a, b)",
     Any,
     Schema::None,
 );
-pub const WALL_OF_CIRCLE: Rule = rule(
+pub(crate) const WALL_OF_CIRCLE: Rule = rule(
     "wall_of_circle",
     &["beam[].section.t"],
     "must be less than half of d",
     Any,
     Schema::None,
 );
-pub const SHAPE: Rule = rule(
+pub(crate) const SHAPE: Rule = rule(
     "shape",
     &["beam[].section.shape"],
     "must be one of rectangle, circle, hollow_rectangle, hollow_circle",
     Any,
     Schema::OneOf(&SHAPES),
 );
-pub const DEFORMATION_SMALL: Rule = rule(
+pub(crate) const DEFORMATION_SMALL: Rule = rule(
     "deformation_small",
     &["beam[].initial.tip_displacement"],
     "must be small against the length (at most half of it)",
     Any,
     Schema::None,
 );
-pub const DEFORMED_TANGENT: Rule = rule(
+pub(crate) const DEFORMED_TANGENT: Rule = rule(
     "deformed_tangent",
     &["beam[].initial.tip_displacement"],
     "needs frame = \"tangent\" (a pinned frame holds the tip on its axis)",
     Any,
     Schema::None,
 );
-pub const BEAM_OUTPUT: Rule = rule(
+pub(crate) const BEAM_OUTPUT: Rule = rule(
     "beam_output",
     &["beam[].outputs[]"],
     "must be one of tip.deflection, tip.x, tip.y, tip.phi, mid.deflection, shape",
     Planar,
     Schema::OneOf(&super::BEAM_OUTPUT_NAMES),
 );
-pub const BEAM_OUTPUT_3D: Rule = rule(
+pub(crate) const BEAM_OUTPUT_3D: Rule = rule(
     "beam_output_3d",
     &["beam[].outputs[]"],
     "must be one of tip.x, tip.y, tip.z, tip.deflection_y, tip.deflection_z, tip.twist, shape",
     Spatial,
     Schema::OneOf(&super::BEAM_OUTPUT_NAMES_3D),
 );
-pub const SHAPE_POINTS: Rule = rule(
+pub(crate) const SHAPE_POINTS: Rule = rule(
     "shape_points",
     &["beam[].shape_points"],
     "must be 0 (no shape outputs) or 2 to 1000 (points from flange a to flange b)",
     Any,
     Schema::AtMost(1000.0),
 );
-pub const BODY_INERTIA_3D: Rule = rule(
+pub(crate) const BODY_INERTIA_3D: Rule = rule(
     "body_inertia_3d",
     &["body[].inertia"],
     "a 3D body with mass needs inertia = [Ixx, Iyy, Izz] (principal, body axes), each positive",
     Spatial,
     Schema::None,
 );
-pub const FRAME_NAME: Rule = rule(
+pub(crate) const FRAME_NAME: Rule = rule(
     "frame_name",
     &["body[].frames.<name>"],
     "frame names are identifiers other than a and b",
     Any,
     Schema::Identifier(&["a", "b"]),
 );
-pub const LAW_PARAMETER: Rule = rule(
+pub(crate) const LAW_PARAMETER: Rule = rule(
     "law_parameter",
     &[
         "joint[].drive.value",
@@ -593,28 +593,28 @@ pub const LAW_PARAMETER: Rule = rule(
     Any,
     Schema::LawParameters,
 );
-pub const TABLE_ROWS: Rule = rule(
+pub(crate) const TABLE_ROWS: Rule = rule(
     "table_rows",
     &["joint[].drive.table", "load[].scale.table"],
     "needs at least two rows [t, value]",
     Any,
     Schema::MinItems(2),
 );
-pub const TABLE_TIMES: Rule = rule(
+pub(crate) const TABLE_TIMES: Rule = rule(
     "table_times",
     &["joint[].drive.table[][]", "load[].scale.table[][]"],
     "times must increase",
     Any,
     Schema::None,
 );
-pub const LAW: Rule = rule(
+pub(crate) const LAW: Rule = rule(
     "law",
     &["joint[].drive.law", "load[].scale.law"],
     "must be one of constant, exponential, spin_up, table, input",
     Any,
     Schema::OneOf(&LAWS),
 );
-pub const ONLY_3D_FIELD: Rule = rule(
+pub(crate) const ONLY_3D_FIELD: Rule = rule(
     "only_3d_field",
     &[
         "beam[].axis",
@@ -626,28 +626,28 @@ pub const ONLY_3D_FIELD: Rule = rule(
     Planar,
     Schema::Absent,
 );
-pub const SPATIAL_FORMULATION: Rule = rule(
+pub(crate) const SPATIAL_FORMULATION: Rule = rule(
     "spatial_formulation",
     &["formulation"],
     ONLY_3D,
     Planar,
     Schema::NoneOf(&["spatial"]),
 );
-pub const FROZEN_INERTIA: Rule = rule(
+pub(crate) const FROZEN_INERTIA: Rule = rule(
     "frozen_inertia",
     &["beam[].inertia"],
     ONLY_3D,
     Planar,
     Schema::NoneOf(&["frozen"]),
 );
-pub const SPHERICAL: Rule = rule(
+pub(crate) const SPHERICAL: Rule = rule(
     "spherical",
     &["joint[].type"],
     ONLY_3D,
     Planar,
     Schema::NoneOf(&["spherical"]),
 );
-pub const IN_PLANE: Rule = rule(
+pub(crate) const IN_PLANE: Rule = rule(
     "in_plane",
     &[
         "world.gravity[2]",
@@ -661,49 +661,49 @@ pub const IN_PLANE: Rule = rule(
     Planar,
     Schema::None,
 );
-pub const PLANAR_INERTIA: Rule = rule(
+pub(crate) const PLANAR_INERTIA: Rule = rule(
     "planar_inertia",
     &["body[].inertia[0]", "body[].inertia[1]"],
     "a planar body has one moment of inertia (about z): give a number",
     Planar,
     Schema::None,
 );
-pub const PLANAR_TORQUE: Rule = rule(
+pub(crate) const PLANAR_TORQUE: Rule = rule(
     "planar_torque",
     &["load[].torque[0]", "load[].torque[1]"],
     "a planar torque acts about z: give a number",
     Planar,
     Schema::None,
 );
-pub const DIRECTION: Rule = rule(
+pub(crate) const DIRECTION: Rule = rule(
     "direction",
     &["beam[].axis", "beam[].normal", "joint[].axis"],
     "must be a non-zero direction",
     Spatial,
     Schema::None,
 );
-pub const NORMAL_TO_AXIS: Rule = rule(
+pub(crate) const NORMAL_TO_AXIS: Rule = rule(
     "normal_to_axis",
     &["beam[].normal"],
     "must be normal to the beam axis (it is the section's local z axis)",
     Spatial,
     Schema::None,
 );
-pub const NORMAL_REQUIRED: Rule = rule(
+pub(crate) const NORMAL_REQUIRED: Rule = rule(
     "normal_required",
     &["beam[].normal"],
     "is required when the beam axis leaves the x–y plane (the default is world z)",
     Spatial,
     Schema::None,
 );
-pub const SHEAR_MODULUS: Rule = rule(
+pub(crate) const SHEAR_MODULUS: Rule = rule(
     "shear_modulus",
     &["beam[].material.G"],
     "a flexible 3D beam needs its shear modulus (torsion)",
     Spatial,
     Schema::None,
 );
-pub const PLANAR_ELEMENT_ONLY: Rule = rule(
+pub(crate) const PLANAR_ELEMENT_ONLY: Rule = rule(
     "planar_element_only",
     &[
         "beam[].modes",
@@ -714,35 +714,35 @@ pub const PLANAR_ELEMENT_ONLY: Rule = rule(
     Spatial,
     Schema::None,
 );
-pub const MATRIX_FILE: Rule = rule(
+pub(crate) const MATRIX_FILE: Rule = rule(
     "matrix_file",
     &["beam[].matrix_file"],
     "is not a valid matrix file (symmetric 12 x 12 mass and stiffness, see the format)",
     Spatial,
     Schema::None,
 );
-pub const MATRIX_ONE_ELEMENT: Rule = rule(
+pub(crate) const MATRIX_ONE_ELEMENT: Rule = rule(
     "matrix_one_element",
     &["beam[].matrix_file"],
     "a matrix-file beam is one flexible element: write elements = 1, no substructures, not rigid",
     Spatial,
     Schema::None,
 );
-pub const MATRIX_LENGTH: Rule = rule(
+pub(crate) const MATRIX_LENGTH: Rule = rule(
     "matrix_length",
     &["beam[].length"],
     "must equal the matrix file's length",
     Spatial,
     Schema::None,
 );
-pub const SPHERICAL_NO_DRIVE: Rule = rule(
+pub(crate) const SPHERICAL_NO_DRIVE: Rule = rule(
     "spherical_no_drive",
     &["joint[].drive"],
     "a spherical joint has no single coordinate to drive",
     Spatial,
     Schema::AbsentWhen("type", "spherical"),
 );
-pub const SPATIAL_EFFECTS: Rule = rule(
+pub(crate) const SPATIAL_EFFECTS: Rule = rule(
     "spatial_effects",
     &["effects[]"],
     "with the 3D element, the effects that can be switched are gravity, flexibility, rayleigh_damping",

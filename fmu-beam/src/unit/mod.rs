@@ -3,10 +3,10 @@
 //! derivatives), shape outputs, natural frequencies and the effects policy (which may run the
 //! integrator). Imports every layer below; `fmi2` above it is the only caller.
 
-pub mod axial_load;
-pub mod effects;
-pub mod engine;
-pub mod interface;
-pub mod modes;
-pub mod shape;
-pub mod variables;
+pub(crate) mod axial_load;
+pub(crate) mod effects;
+pub(crate) mod engine;
+pub(crate) mod interface;
+pub(crate) mod modes;
+pub(crate) mod shape;
+pub(crate) mod variables;

@@ -18,8 +18,6 @@ use crate::scene::{BeamSpec, Scene, SHAPE_OUTPUT};
 use crate::unit::effects::Effects;
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
-pub use crate::scene::MAX_POINTS;
-
 /// Distances from flange a, along the undeformed axis, of the shape points of a beam (rigid:
 /// its two ends unless the scene asks for more); empty when the beam offers no shape.
 pub fn stations(beam: &BeamSpec, rigid: bool) -> Vec<f64> {

@@ -45,9 +45,7 @@ pub fn run(scene: Scene, params: &[(&str, f64)], outputs: &[&str], hc: f64, stop
             .unwrap_or_else(|| panic!("no parameter {p}"))
             .clone();
         match var.ty {
-            fmu_beam::unit::variables::VarType::Boolean => {
-                e.set_boolean(var.vr, *v != 0.0).unwrap()
-            }
+            fmu_beam::VarType::Boolean => e.set_boolean(var.vr, *v != 0.0).unwrap(),
             _ => e.set_real(var.vr, *v).unwrap(),
         }
     }

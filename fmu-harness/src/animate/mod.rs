@@ -3,7 +3,7 @@
 //! A run comes from a CSV that `simulate` or `cosim` wrote, from an FMU (run here with its
 //! DefaultExperiment through [`crate::simulate`]) or from a scene file (run directly by the
 //! engine). [`Motion::from_run`] finds the beams by their shape outputs
-//! (`<beam>.shape.x[i]`, [`fmu_beam::unit::shape`]) and, where a scene is known, the rigid bodies
+//! (`<beam>.shape.x[i]`, the unit's shape outputs) and, where a scene is known, the rigid bodies
 //! and joints by their pose outputs. [`gif`] writes an animated GIF (the `gif` crate encodes,
 //! `embedded-graphics` draws); [`html`] a self-contained page that plays the run with a time
 //! slider, play/pause, speed, a deformation magnification and, in 3D, a view turned with the

@@ -3,7 +3,7 @@
 
 use super::{AnimateError, KnownScene};
 use crate::HarnessError;
-use fmu_beam::unit::variables::{Binding, VarType};
+use fmu_beam::{Binding, VarType};
 use fmu_beam::{Engine, Scene};
 use std::io::Read;
 use std::path::Path;
@@ -159,7 +159,7 @@ pub fn run_scene(
         .variables
         .iter()
         .filter(|v| matches!(v.binding, Binding::Output(_)) && v.ty != VarType::Boolean)
-        .filter(|v| v.causality == fmu_beam::unit::variables::Causality::Output)
+        .filter(|v| v.causality == fmu_beam::Causality::Output)
         .map(|v| (v.vr, v.ty, v.name.clone()))
         .collect();
     let mut columns = vec!["time".to_string()];

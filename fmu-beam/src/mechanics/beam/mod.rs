@@ -1,8 +1,8 @@
 //! Beam sections and finite elements (planar paper §3).
 
-pub mod planar_beam;
-pub mod planar_element;
-pub mod section;
-pub mod spatial_beam;
-pub mod spatial_element;
-pub mod spatial_section;
+pub(crate) mod planar_beam;
+pub(crate) mod planar_element;
+pub(crate) mod section;
+pub(crate) mod spatial_beam;
+pub(crate) mod spatial_element;
+pub(crate) mod spatial_section;

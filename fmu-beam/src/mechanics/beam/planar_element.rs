@@ -42,7 +42,8 @@ pub fn slope(xi: f64, l: f64) -> [f64; ELEMENT_DOFS] {
 }
 
 /// Curvature d²v/dx² at ξ, as a row over the element coordinates.
-pub fn curvature(xi: f64, l: f64) -> [f64; ELEMENT_DOFS] {
+#[cfg(test)]
+pub(crate) fn curvature(xi: f64, l: f64) -> [f64; ELEMENT_DOFS] {
     [
         0.0,
         (-6.0 + 12.0 * xi) / (l * l),

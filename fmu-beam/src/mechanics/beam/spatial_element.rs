@@ -47,6 +47,7 @@ fn hermite_dx(xi: f64, l: f64) -> [f64; 4] {
 }
 
 /// d²/dx² of [`hermite`].
+#[cfg(test)]
 fn hermite_dxx(xi: f64, l: f64) -> [f64; 4] {
     [
         (-6.0 + 12.0 * xi) / (l * l),
@@ -96,7 +97,8 @@ pub fn section_rotation(xi: f64, l: f64) -> [Row; 3] {
 }
 
 /// Strain rows at ξ: axial strain u', twist rate θx', curvatures v'' and w''.
-pub fn strains(xi: f64, l: f64) -> [Row; 4] {
+#[cfg(test)]
+pub(crate) fn strains(xi: f64, l: f64) -> [Row; 4] {
     let mut du = [0.0; ELEMENT_DOFS];
     du[U] = -1.0 / l;
     du[NODE_DOFS + U] = 1.0 / l;

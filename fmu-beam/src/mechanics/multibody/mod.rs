@@ -1,16 +1,16 @@
 //! Bodies, frames and joints, assembled into M(q) q'' + G(q)ᵀλ = Q(q, q', t); g(q, t) = 0.
 
-pub mod body;
-pub mod equations;
-pub mod frame;
-pub mod joint;
-pub mod law;
-pub mod prismatic;
-pub mod revolute;
-pub mod rigid_body;
-pub mod sparsity;
-pub mod system;
-pub mod weld;
+pub(crate) mod body;
+pub(crate) mod equations;
+pub(crate) mod frame;
+pub(crate) mod joint;
+pub(crate) mod law;
+pub(crate) mod prismatic;
+pub(crate) mod revolute;
+pub(crate) mod rigid_body;
+pub(crate) mod sparsity;
+pub(crate) mod system;
+pub(crate) mod weld;
 
 pub use equations::{CoordinateKind, Equations, Turning};
 pub use sparsity::{BlockDiagonal, JacobianRows};

@@ -29,16 +29,16 @@
 //! column; the bias is a second directional difference of g along q' plus the drive law's
 //! second derivative. The norm rows are exact.
 
-pub mod body;
-pub mod build;
-pub mod frame;
-pub mod joint;
-pub mod quaternion;
-pub mod rigid_body;
-pub mod system;
+pub(crate) mod body;
+pub(crate) mod build;
+pub(crate) mod frame;
+pub(crate) mod joint;
+pub(crate) mod quaternion;
+pub(crate) mod rigid_body;
+pub(crate) mod system;
 
 pub use body::Body3;
 pub use frame::Frame3;
-pub use joint::{Joint3, JointKind3};
+pub use joint::JointKind3;
 pub use rigid_body::RigidBody3;
 pub use system::{Load3, System3};

@@ -6,18 +6,16 @@
 //! lets a spinning chain keep its factors; and the error estimate's filter through the matrix
 //! weighs each mode as the step resolves it.
 
-mod common;
-
-use common::{scene, vr};
-use fmu_beam::integrator::iteration_matrix::{prefers_sparse, SPARSE_MIN_SIZE};
-use fmu_beam::integrator::{
+use super::common::{scene, vr};
+use crate::integrator::iteration_matrix::{prefers_sparse, SPARSE_MIN_SIZE};
+use crate::integrator::{
     initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
     Stepper,
 };
-use fmu_beam::mechanics::multibody::{Equations, Turning};
-use fmu_beam::mechanics::Mechanics;
-use fmu_beam::unit::effects::resolve;
-use fmu_beam::{Engine, Scene};
+use crate::mechanics::multibody::{Equations, Turning};
+use crate::mechanics::Mechanics;
+use crate::unit::effects::resolve;
+use crate::{Engine, Scene};
 use nalgebra::{DMatrix, DVector};
 
 /// `file` with its first beam in `k` substructures (of its own elements each), at a fixed step.

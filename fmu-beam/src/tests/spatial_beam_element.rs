@@ -6,18 +6,16 @@
 //! states give the planar beam's terms to 1e-12), the frozen-inertia variant and the beam from
 //! a matrix file (parser refusals, the element's own matrices reproducing the element).
 
-use fmu_beam::mechanics::beam::planar_beam::{PlanarBeam, FLEX as PFLEX};
-use fmu_beam::mechanics::beam::planar_element::GAUSS_4;
-use fmu_beam::mechanics::beam::spatial_beam::{
+use crate::mechanics::beam::planar_beam::{PlanarBeam, FLEX as PFLEX};
+use crate::mechanics::beam::planar_element::GAUSS_4;
+use crate::mechanics::beam::spatial_beam::{
     skew, InertiaModel, SpatialBeam, SpatialBeamProps, FLEX, OMEGA,
 };
-use fmu_beam::mechanics::beam::spatial_element::{
-    self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W,
-};
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
-use fmu_beam::mechanics::multibody3d::build::matrix_file_beam;
-use fmu_beam::scene::matrix_file::{self, MatrixFile, MatrixFileError};
-use fmu_beam::scene::FrameKind;
+use crate::mechanics::beam::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
+use crate::mechanics::beam::spatial_section::SpatialSection;
+use crate::mechanics::multibody3d::build::matrix_file_beam;
+use crate::scene::matrix_file::{self, MatrixFile, MatrixFileError};
+use crate::scene::FrameKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector2, Vector3};
 
 /// Deterministic pseudo-random numbers in [-1, 1].

@@ -3,15 +3,13 @@
 //! Jacobian of every joint kind with and without a motion drive, the joint-coordinate gradient
 //! (joint rates, effort drives) and the generalized force of a load.
 
-mod common;
-
-use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
-use fmu_beam::mechanics::multibody::joint::Drive;
-use fmu_beam::mechanics::multibody::law::{Law, TimeLaw};
-use fmu_beam::mechanics::multibody::Equations;
-use fmu_beam::mechanics::multibody3d::{JointKind3, Load3, RigidBody3, System3};
-use fmu_beam::scene::{DriveKind, FrameKind};
+use crate::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use crate::mechanics::beam::spatial_section::SpatialSection;
+use crate::mechanics::multibody::joint::Drive;
+use crate::mechanics::multibody::law::{Law, TimeLaw};
+use crate::mechanics::multibody::Equations;
+use crate::mechanics::multibody3d::{JointKind3, Load3, RigidBody3, System3};
+use crate::scene::{DriveKind, FrameKind};
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
 /// A small deterministic generator (xorshift) of numbers in [−1, 1].
@@ -120,7 +118,7 @@ fn system(rng: &mut Random) -> System3 {
 /// A random state: frames moved and turned, quaternions off the unit sphere, beams deformed
 /// (section rotations up to about 0.3 rad).
 fn state(sys: &System3, rng: &mut Random) -> DVector<f64> {
-    let scene = common::scene("flexible_pendulum.toml"); // not read by System3
+    let scene = super::common::scene("flexible_pendulum.toml"); // not read by System3
     let mut q = sys.initial_coordinates(&scene).expect("placement");
     for i in 0..sys.bodies.len() {
         let o = sys.offsets[i];
@@ -231,7 +229,7 @@ fn load_force_matches_central_differences_of_the_frame_pose() {
 /// differences) leave the round-off of the forward differences below the tolerance.
 #[test]
 fn body_tangents_match_central_differences_of_the_residual() {
-    use fmu_beam::mechanics::multibody3d::Body3;
+    use crate::mechanics::multibody3d::Body3;
     let mut rng = Random(0x0bad_cafe_f00d_d00d);
     let sys = system(&mut rng);
     let mut bodies: Vec<Body3> = sys.bodies.clone();

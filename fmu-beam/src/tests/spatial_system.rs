@@ -4,14 +4,12 @@
 //! with the planar engine; case C6's flexible pendulum lags its rigid twin (lag printed with
 //! its convergence over elements).
 
-mod common;
-
-use fmu_beam::integrator::{initial_state, GaState, Settings, Stats, Stepper};
-use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
-use fmu_beam::mechanics::multibody3d::quaternion::{g_body, rotation};
-use fmu_beam::mechanics::multibody3d::{JointKind3, RigidBody3, System3};
-use fmu_beam::scene::FrameKind;
+use crate::integrator::{initial_state, GaState, Settings, Stats, Stepper};
+use crate::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use crate::mechanics::beam::spatial_section::SpatialSection;
+use crate::mechanics::multibody3d::quaternion::{g_body, rotation};
+use crate::mechanics::multibody3d::{JointKind3, RigidBody3, System3};
+use crate::scene::FrameKind;
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 fn fixed(h: f64) -> Settings {
@@ -33,7 +31,7 @@ fn simulate(
     stop: f64,
     mut record: impl FnMut(&GaState),
 ) -> GaState {
-    let scene = common::scene("flexible_pendulum.toml"); // not read by System3
+    let scene = super::common::scene("flexible_pendulum.toml"); // not read by System3
     let mut st = initial_state(sys, &scene, 0.0, &settings).expect("assembles");
     let mut stepper = Stepper::new(sys, settings);
     let mut stats = Stats::default();
@@ -71,7 +69,7 @@ fn quaternion_rates_give_the_body_angular_velocity_and_its_derivative() {
     // Ȧ = A ω̃ with ω = 2 G(p) ṗ
     let w = g_body(&p) * pd * 2.0;
     let ad = (rotation(&path(t + h)) - rotation(&path(t - h))) / (2.0 * h);
-    let err = (ad - rotation(&p) * fmu_beam::mechanics::beam::spatial_beam::skew(&w)).amax();
+    let err = (ad - rotation(&p) * crate::mechanics::beam::spatial_beam::skew(&w)).amax();
     println!("|Ȧ − A ω̃| = {err:.2e}");
     assert!(err < 1e-7);
     // ω̇ = 2 G(p) p̈
@@ -164,9 +162,9 @@ fn c2_3d(h: f64) -> Vec<(f64, f64)> {
 
 fn c2_planar(h: f64) -> Vec<(f64, f64)> {
     // the 3D element has no geometric stiffening: the planar one without it
-    let mut scene = common::scene("flexible_pendulum.toml");
+    let mut scene = super::common::scene("flexible_pendulum.toml");
     scene.beams[0].geometric_stiffening = false;
-    let r = common::run(
+    let r = super::common::run(
         scene,
         &[
             ("solver.adaptive", 0.0),
@@ -259,7 +257,7 @@ fn c6(elements: Option<usize>, settings: Settings, hc: f64) -> Vec<f64> {
             sys.beam_frame(g, false, axes)
         }
         None => {
-            let beam = fmu_beam::mechanics::beam::spatial_beam::SpatialBeam::new("beam", &props);
+            let beam = crate::mechanics::beam::spatial_beam::SpatialBeam::new("beam", &props);
             let b = sys.add_rigid(
                 RigidBody3::of_beam(&beam, vec![("a".into(), Vector3::zeros(), axes)]),
                 Vector3::zeros(),
@@ -335,7 +333,7 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
     let exact = c6_exact_rigid(hc);
     // the rigid twin's inertia about the hinge axis (world y = the beam's y) and its mass
     let props = c5_beam(0.2, 1, 0.0);
-    let beam = fmu_beam::mechanics::beam::spatial_beam::SpatialBeam::new("beam", &props);
+    let beam = crate::mechanics::beam::spatial_beam::SpatialBeam::new("beam", &props);
     let m = beam.mass;
     let j_hinge = beam.undeformed.i0[(1, 1)];
     assert!((m / (7800.0 * 0.02 * 0.06285 * 0.2) - 1.0).abs() < 1e-12);
@@ -392,13 +390,13 @@ fn c5(k: usize, axis: usize) -> (f64, f64) {
     let tip = sys.beam_frame(g, true, Matrix3::identity());
     let mut torque = Vector3::zeros();
     torque[axis] = 2.0 * std::f64::consts::PI * ei;
-    sys.add_load(fmu_beam::mechanics::multibody3d::Load3 {
+    sys.add_load(crate::mechanics::multibody3d::Load3 {
         name: "moment".into(),
         frame: tip,
         force: Vector3::zeros(),
         torque,
-        law: Some(fmu_beam::mechanics::multibody::law::TimeLaw {
-            law: fmu_beam::mechanics::multibody::law::Law::Table(vec![[0.0, 0.0], [2.0, 1.0]]),
+        law: Some(crate::mechanics::multibody::law::TimeLaw {
+            law: crate::mechanics::multibody::law::Law::Table(vec![[0.0, 0.0], [2.0, 1.0]]),
             until: None,
         }),
     });

@@ -37,18 +37,16 @@
 //!   run's Newton stopping error keeps accumulating with the step count (h = 1e-3: 4.3e-7 up
 //!   to 10 s, 6.3e-7 over 20 s, against 1e-6 asserted).
 
-mod common;
-
-use fmu_beam::integrator::{initial_state, Settings, Stats, Stepper};
-use fmu_beam::mechanics::beam::planar_beam::{BeamOptions, PlanarBeam};
-use fmu_beam::mechanics::beam::section::Section;
-use fmu_beam::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
-use fmu_beam::mechanics::beam::spatial_element::{NODE_DOFS, TZ, U, V};
-use fmu_beam::mechanics::beam::spatial_section::SpatialSection;
-use fmu_beam::mechanics::multibody::joint::Drive;
-use fmu_beam::mechanics::multibody::law::TimeLaw;
-use fmu_beam::mechanics::multibody3d::{Body3, Frame3, JointKind3, RigidBody3, System3};
-use fmu_beam::scene::{BeamSpec, Scene};
+use crate::integrator::{initial_state, Settings, Stats, Stepper};
+use crate::mechanics::beam::planar_beam::{BeamOptions, PlanarBeam};
+use crate::mechanics::beam::section::Section;
+use crate::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
+use crate::mechanics::beam::spatial_element::{NODE_DOFS, TZ, U, V};
+use crate::mechanics::beam::spatial_section::SpatialSection;
+use crate::mechanics::multibody::joint::Drive;
+use crate::mechanics::multibody::law::TimeLaw;
+use crate::mechanics::multibody3d::{Body3, Frame3, JointKind3, RigidBody3, System3};
+use crate::scene::{BeamSpec, Scene};
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 use std::time::Instant;
 
@@ -94,11 +92,11 @@ struct Series {
 /// The planar engine on `file`, stepped by `grid`: `outputs` every `grid.hc`.
 fn planar(file: &str, grid: Grid, outputs: &[&str]) -> Series {
     // the 3D element has no geometric stiffening: compare the planar engine without it
-    let mut scene = common::scene(file);
+    let mut scene = super::common::scene(file);
     for b in &mut scene.beams {
         b.geometric_stiffening = false;
     }
-    let mut r = common::run(
+    let mut r = super::common::run(
         scene,
         &[
             ("solver.adaptive", 0.0),
@@ -110,7 +108,7 @@ fn planar(file: &str, grid: Grid, outputs: &[&str]) -> Series {
         grid.stop,
     );
     let mut counter = |name: &str| {
-        let vr = common::vr(&r.engine, name);
+        let vr = super::common::vr(&r.engine, name);
         r.engine.get_integer(vr).expect("a counter") as u64
     };
     let (steps, rejected) = (counter("solver.steps"), counter("solver.rejected_steps"));
@@ -275,7 +273,7 @@ fn differences(a3d: &[Vec<f64>], a2d: &[Vec<f64>]) -> Vec<f64> {
 /// same steps in both runs, each difference shrinking from the coarser step to the finer (or at
 /// rounding level, below 1e-9, at both), each below 1e-6 at the finer step.
 fn agree(case: Case) {
-    let scene = common::scene(case.file);
+    let scene = super::common::scene(case.file);
     // the table, printed whole (the cases run on parallel threads)
     let mut table = format!(
         "{}: max |3D − planar| / max |planar| over {} s, communication step {} s, Newton \

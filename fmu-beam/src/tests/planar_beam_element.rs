@@ -2,10 +2,10 @@
 //! integration of ∫ρ LᵀL (eq. (11)), the quadratic-velocity vector against Lagrange's
 //! equations, the tangents against finite differences, and zero force at rest.
 
-use fmu_beam::mechanics::beam::planar_beam::{rot, BeamOptions, PlanarBeam, FLEX, THETA};
-use fmu_beam::mechanics::beam::planar_element::{shape, GAUSS_4};
-use fmu_beam::mechanics::beam::section::Section;
-use fmu_beam::scene::FrameKind;
+use crate::mechanics::beam::planar_beam::{rot, BeamOptions, PlanarBeam, FLEX, THETA};
+use crate::mechanics::beam::planar_element::{shape, GAUSS_4};
+use crate::mechanics::beam::section::Section;
+use crate::scene::FrameKind;
 use nalgebra::{DMatrix, DVector, Vector2};
 
 /// Deterministic pseudo-random numbers in [-1, 1].
