@@ -1,0 +1,161 @@
+//! FMU state (fmi2GetFMUstate, fmi2SerializeFMUstate): a snapshot of everything that changes
+//! while an instance runs, its restore, and its byte form (versioned, fingerprinted by the
+//! scene, read back with bounds checks).
+
+use super::{Engine, Model, ModelState, Snapshot};
+use crate::error::EngineError;
+use crate::integrator::{write_vec, GaState, Memory, Reader, Stats};
+
+const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
+const STATE_VERSION: u32 = 5;
+
+impl Engine {
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            initialized: self.initialized,
+            start_time: self.start_time,
+            values: self.values.clone(),
+            input_ders: self.input_ders.clone(),
+            model: self.model.as_ref().map(Model::save),
+        }
+    }
+
+    pub fn restore(&mut self, s: &Snapshot) -> Result<(), EngineError> {
+        self.values = s.values.clone();
+        self.input_ders = s.input_ders.clone();
+        self.start_time = s.start_time;
+        self.model = None;
+        self.initialized = false;
+        if let Some(saved) = &s.model {
+            let m = self.built()?;
+            let (n, k) = (m.state.q.len(), m.state.lambda.len());
+            let fits = |st: &GaState| st.q.len() == n && st.lambda.len() == k;
+            let ahead_fits = fits(&saved.front) && saved.back.as_ref().is_none_or(fits);
+            let point_fits = saved
+                .memory
+                .point
+                .as_ref()
+                .is_none_or(|p| p.q.len() == n && p.lambda.len() == k);
+            if !fits(&saved.state) || !ahead_fits || !point_fits {
+                return Err(EngineError::BadState {
+                    message: "the state does not belong to this model".into(),
+                });
+            }
+            if saved.applied_inputs.len() != m.applied_inputs.len() {
+                return Err(EngineError::BadState {
+                    message: "the state has another number of inputs".into(),
+                });
+            }
+            m.put_back(saved.clone());
+        }
+        self.initialized = s.initialized;
+        Ok(())
+    }
+
+    /// A fingerprint of the scene, so that a state is only restored into the same model.
+    fn fingerprint(&self) -> u64 {
+        // FNV-1a over the canonical scene text.
+        let text = self.scene.to_toml_string();
+        text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+    }
+
+    pub fn serialize(&self, s: &Snapshot) -> Vec<u8> {
+        let mut w = Vec::new();
+        w.extend_from_slice(STATE_MAGIC);
+        w.extend_from_slice(&STATE_VERSION.to_le_bytes());
+        w.extend_from_slice(&self.fingerprint().to_le_bytes());
+        w.push(s.initialized as u8);
+        w.extend_from_slice(&s.start_time.to_le_bytes());
+        write_vec(&mut w, &s.values);
+        let ders: Vec<f64> = s.input_ders.iter().flatten().copied().collect();
+        write_vec(&mut w, &ders);
+        match &s.model {
+            None => w.push(0),
+            Some(ms) => {
+                w.push(1);
+                ms.state.write(&mut w);
+                ms.front.write(&mut w);
+                match &ms.back {
+                    None => w.push(0),
+                    Some(b) => {
+                        w.push(1);
+                        b.write(&mut w);
+                    }
+                }
+                ms.stats.write(&mut w);
+                write_vec(&mut w, &ms.applied_inputs);
+                ms.memory.write(&mut w);
+            }
+        }
+        w
+    }
+
+    pub fn deserialize(&self, bytes: &[u8]) -> Result<Snapshot, EngineError> {
+        let mut r = Reader::new(bytes);
+        let bad = |m: &str| EngineError::BadState {
+            message: m.to_string(),
+        };
+        if r.take(8)? != STATE_MAGIC {
+            return Err(bad(
+                "not a serialized state of this FMU (wrong magic bytes)",
+            ));
+        }
+        if r.u32()? != STATE_VERSION {
+            return Err(bad("serialized state of another format version"));
+        }
+        if r.u64()? != self.fingerprint() {
+            return Err(bad("serialized state of another scene"));
+        }
+        let initialized = match r.u8()? {
+            0 => false,
+            1 => true,
+            _ => return Err(bad("corrupt flag")),
+        };
+        let start_time = r.f64()?;
+        let values = r.vec()?;
+        if values.len() != self.values.len() {
+            return Err(bad("wrong number of parameter values"));
+        }
+        let ders = r.vec()?;
+        if ders.len() != 2 * self.values.len() {
+            return Err(bad("wrong number of input derivatives"));
+        }
+        let input_ders = ders.chunks(2).map(|c| [c[0], c[1]]).collect();
+        let model = match r.u8()? {
+            0 => None,
+            1 => {
+                let state = GaState::read(&mut r)?;
+                let front = GaState::read(&mut r)?;
+                let back = match r.u8()? {
+                    0 => None,
+                    1 => Some(GaState::read(&mut r)?),
+                    _ => return Err(bad("corrupt flag")),
+                };
+                Some(ModelState {
+                    state,
+                    front,
+                    back,
+                    stats: Stats::read(&mut r)?,
+                    applied_inputs: r.vec()?,
+                    memory: Memory::read(&mut r)?,
+                })
+            }
+            _ => return Err(bad("corrupt flag")),
+        };
+        if r.pos() != bytes.len() {
+            return Err(bad("trailing bytes after the state"));
+        }
+        if values.iter().chain(ders.iter()).any(|v| !v.is_finite()) || !start_time.is_finite() {
+            return Err(bad("non-finite values"));
+        }
+        Ok(Snapshot {
+            initialized,
+            start_time,
+            values,
+            input_ders,
+            model,
+        })
+    }
+}
