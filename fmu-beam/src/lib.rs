@@ -16,5 +16,7 @@ pub mod scene;
 pub mod unit;
 
 pub use error::EngineError;
+/// The FMI 2.0 C types, one definition for the unit (`fmi2`) and fmu-harness's master binding.
+pub use fmi2::types as fmi2_types;
 pub use scene::Scene;
 pub use unit::engine::Engine;
