@@ -27,7 +27,7 @@ extern crate self as fmu_beam;
 
 pub use error::EngineError;
 pub use fmi2::logger::LOG_CATEGORIES;
-/// The C types of the FMI 2.0 headers, shared by the unit's exports and a master's binding.
+/// The FMI 2.0 C types, one definition for the unit (`fmi2`) and fmu-harness's master binding.
 pub use fmi2::types as fmi2_types;
 pub use scene::{Scene, SceneError};
 pub use unit::effects::{resolve as resolve_effects, Decision, Resolution, EFFECTS};

@@ -5,7 +5,7 @@ use crate::error::HarnessError;
 use crate::{animate, cosim, modes, package, reference, schema, simulate};
 use clap::{Parser, Subcommand};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -138,65 +138,20 @@ pub enum Command {
 
 /// Runs one command, writing its report to `out`.
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
-    let stdout_err = |e| HarnessError::io("<stdout>", "writing the report", e);
     match cli.command {
         Command::Package {
             scene,
             output,
             binary,
-        } => {
-            let p = package::package(&scene, &output, &binary)?;
-            let engines: Vec<String> = p
-                .binaries
-                .iter()
-                .map(|(platform, path)| format!("{platform} {}", path.display()))
-                .collect();
-            writeln!(
-                out,
-                "{}: {} ({} variables, GUID {}, engines: {})",
-                p.output.display(),
-                p.model_identifier,
-                p.variables,
-                p.guid,
-                engines.join(", ")
-            )
-            .map_err(stdout_err)?;
-        }
+        } => package_cmd(&scene, &output, &binary, out),
         Command::Simulate {
             fmu,
             stop,
             step,
             output,
             csv,
-        } => {
-            let options = simulate::Options {
-                stop_time: stop,
-                step,
-                outputs: output,
-            };
-            let text = simulate::simulate(&fmu, &options)?.csv();
-            match csv {
-                Some(path) => std::fs::write(&path, text)
-                    .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?,
-                None => out.write_all(text.as_bytes()).map_err(stdout_err)?,
-            }
-        }
-        Command::Cosim { system, csv } => {
-            let (results, summary) = cosim::cosim(&system)?;
-            match csv {
-                Some(path) => {
-                    std::fs::write(&path, results.csv())
-                        .map_err(|e| HarnessError::io(&path, "writing the CSV", e))?;
-                    writeln!(out, "{}wrote {}", summary.text(), path.display())
-                        .map_err(stdout_err)?;
-                }
-                None => {
-                    out.write_all(results.csv().as_bytes())
-                        .map_err(stdout_err)?;
-                    eprint!("{}", summary.text());
-                }
-            }
-        }
+        } => simulate_cmd(&fmu, stop, step, output, csv.as_deref(), out),
+        Command::Cosim { system, csv } => cosim_cmd(&system, csv.as_deref(), out),
         Command::Animate {
             run,
             output,
@@ -210,119 +165,258 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             step,
             csv,
             metadata,
-        } => {
-            let (width, height) = parse_size(&size)?;
-            let started = std::time::Instant::now();
-            let mut scenes: Vec<animate::KnownScene> = scene
-                .iter()
-                .map(|s| animate::known_scene(s))
-                .collect::<Result<_, _>>()?;
-            let ext = run.extension().and_then(|e| e.to_str()).unwrap_or("");
-            let stem = run
-                .file_stem()
-                .map_or("run".into(), |s| s.to_string_lossy().to_string());
-            let (recording, title) = match ext {
-                "fmu" => {
-                    let (rec, packaged) = animate::run_fmu(&run, stop, step)?;
-                    if let (Some(s), true) = (packaged, scenes.is_empty()) {
-                        scenes.push(animate::KnownScene {
-                            prefix: String::new(),
-                            scene: s,
-                        });
-                    }
-                    (rec, stem)
-                }
-                "toml" => {
-                    let s = fmu_beam::Scene::load(&run)?;
-                    let rec = animate::run_scene(&s, &run.display().to_string(), stop, step)?;
-                    let name = s.name.clone();
-                    if scenes.is_empty() {
-                        scenes.push(animate::KnownScene {
-                            prefix: String::new(),
-                            scene: s,
-                        });
-                    }
-                    (rec, name)
-                }
-                _ => (animate::read_csv(&run)?, stem),
-            };
-            let ran = started.elapsed().as_secs_f64();
-            if let Some(path) = &csv {
-                std::fs::write(path, recording.csv())
-                    .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
-            }
-            if output.is_none() && gif.is_none() {
-                return Err(animate::AnimateError::BadOption {
-                    name: "--output/--gif",
-                    value: "none".into(),
-                    rule: "give the page (-o run.html), the GIF (--gif run.gif) or both",
-                }
-                .into());
-            }
-            let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
-            let options = animate::Options {
-                html: output,
+        } => animate_cmd(
+            AnimateArgs {
+                run,
+                output,
                 gif,
-                metadata,
+                scene,
                 fps,
                 speed,
-                magnification: magnify,
-                width,
-                height,
-            };
-            let (m, written) = animate::write(&motion, &options)?;
-            writeln!(
-                out,
-                "{title}: {} recorded times from {} to {} s ({:.2} s to get them); {} beam(s), \
-                 {} bodies, {} joints; deformation x {m} (largest deflection {:.3} % of its \
-                 beam's length)",
-                motion.times.len(),
-                motion.times[0],
-                motion.times[motion.times.len() - 1],
-                ran,
-                motion.beams.len(),
-                motion.bodies.len(),
-                motion.joints.len(),
-                100.0 * motion.largest_deflection_ratio()
-            )
-            .map_err(stdout_err)?;
-            if scenes.is_empty() {
-                writeln!(
-                    out,
-                    "(beams only: give --scene FILE to draw the bodies and joints of a CSV)"
-                )
-                .map_err(stdout_err)?;
-            }
-            for w in written {
-                writeln!(
-                    out,
-                    "wrote {} ({} frames, {:.1} kB, {:.2} s)",
-                    w.path.display(),
-                    w.frames,
-                    w.bytes as f64 / 1024.0,
-                    w.seconds
-                )
-                .map_err(stdout_err)?;
-            }
-        }
-        Command::Explain { scene } => {
-            let scene = fmu_beam::Scene::load(&scene)?;
-            let text = fmu_beam::resolve_effects(&scene).explain(&scene);
-            out.write_all(text.as_bytes()).map_err(stdout_err)?;
-        }
+                magnify,
+                size,
+                stop,
+                step,
+                csv,
+                metadata,
+            },
+            out,
+        ),
+        Command::Explain { scene } => explain_cmd(&scene, out),
         Command::Schema { output } => {
-            write_text(&schema::scene_schema_text(), output.as_deref(), out)?;
+            write_text(&schema::scene_schema_text(), output.as_deref(), out)
         }
         Command::Reference { output } => {
-            write_text(&reference::scene_reference(), output.as_deref(), out)?;
+            write_text(&reference::scene_reference(), output.as_deref(), out)
         }
-        Command::Modes { scene, count } => {
-            let f = modes::elastic_frequencies(&scene)?;
-            out.write_all(modes::report(&f, count).as_bytes())
+        Command::Modes { scene, count } => modes_cmd(&scene, count, out),
+    }
+}
+
+/// The error of writing the report to standard output (or the `out` given to [`run`]).
+fn stdout_err(e: std::io::Error) -> HarnessError {
+    HarnessError::io("<stdout>", "writing the report", e)
+}
+
+/// `package`: writes the FMU and one line naming it, its variables, GUID and engines.
+fn package_cmd(
+    scene: &Path,
+    output: &Path,
+    binary: &[package::BinaryArg],
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let p = package::package(scene, output, binary)?;
+    let engines: Vec<String> = p
+        .binaries
+        .iter()
+        .map(|(platform, path)| format!("{platform} {}", path.display()))
+        .collect();
+    writeln!(
+        out,
+        "{}: {} ({} variables, GUID {}, engines: {})",
+        p.output.display(),
+        p.model_identifier,
+        p.variables,
+        p.guid,
+        engines.join(", ")
+    )
+    .map_err(stdout_err)
+}
+
+/// `simulate`: runs the FMU and writes its CSV to `csv` or `out`.
+fn simulate_cmd(
+    fmu: &Path,
+    stop: Option<f64>,
+    step: Option<f64>,
+    outputs: Vec<String>,
+    csv: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let options = simulate::Options {
+        stop_time: stop,
+        step,
+        outputs,
+    };
+    let text = simulate::simulate(fmu, &options)?.csv();
+    match csv {
+        Some(path) => {
+            std::fs::write(path, text).map_err(|e| HarnessError::io(path, "writing the CSV", e))
+        }
+        None => out.write_all(text.as_bytes()).map_err(stdout_err),
+    }
+}
+
+/// `cosim`: runs the system; the CSV goes to `csv` (summary to `out`) or to `out` (summary to
+/// standard error).
+fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let (results, summary) = cosim::cosim(system)?;
+    match csv {
+        Some(path) => {
+            std::fs::write(path, results.csv())
+                .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+            writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)
+        }
+        None => {
+            out.write_all(results.csv().as_bytes())
                 .map_err(stdout_err)?;
+            eprint!("{}", summary.text());
+            Ok(())
         }
     }
+}
+
+/// The options of `animate`, as [`Command::Animate`] holds them.
+struct AnimateArgs {
+    run: PathBuf,
+    output: Option<PathBuf>,
+    gif: Option<PathBuf>,
+    scene: Vec<String>,
+    fps: f64,
+    speed: f64,
+    magnify: Option<f64>,
+    size: String,
+    stop: Option<f64>,
+    step: Option<f64>,
+    csv: Option<PathBuf>,
+    metadata: Option<PathBuf>,
+}
+
+/// `animate`: gets the run (CSV read, FMU or scene run here), writes the page and/or GIF, and
+/// reports what it drew.
+fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let AnimateArgs {
+        run,
+        output,
+        gif,
+        scene,
+        fps,
+        speed,
+        magnify,
+        size,
+        stop,
+        step,
+        csv,
+        metadata,
+    } = args;
+    let (width, height) = parse_size(&size)?;
+    let started = std::time::Instant::now();
+    let mut scenes: Vec<animate::KnownScene> = scene
+        .iter()
+        .map(|s| animate::known_scene(s))
+        .collect::<Result<_, _>>()?;
+    let (recording, title) = animate_recording(&run, stop, step, &mut scenes)?;
+    let ran = started.elapsed().as_secs_f64();
+    if let Some(path) = &csv {
+        std::fs::write(path, recording.csv())
+            .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+    }
+    if output.is_none() && gif.is_none() {
+        return Err(animate::AnimateError::BadOption {
+            name: "--output/--gif",
+            value: "none".into(),
+            rule: "give the page (-o run.html), the GIF (--gif run.gif) or both",
+        }
+        .into());
+    }
+    let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
+    let options = animate::Options {
+        html: output,
+        gif,
+        metadata,
+        fps,
+        speed,
+        magnification: magnify,
+        width,
+        height,
+    };
+    let (m, written) = animate::write(&motion, &options)?;
+    writeln!(
+        out,
+        "{title}: {} recorded times from {} to {} s ({:.2} s to get them); {} beam(s), \
+         {} bodies, {} joints; deformation x {m} (largest deflection {:.3} % of its \
+         beam's length)",
+        motion.times.len(),
+        motion.times[0],
+        motion.times[motion.times.len() - 1],
+        ran,
+        motion.beams.len(),
+        motion.bodies.len(),
+        motion.joints.len(),
+        100.0 * motion.largest_deflection_ratio()
+    )
+    .map_err(stdout_err)?;
+    if scenes.is_empty() {
+        writeln!(
+            out,
+            "(beams only: give --scene FILE to draw the bodies and joints of a CSV)"
+        )
+        .map_err(stdout_err)?;
+    }
+    for w in written {
+        writeln!(
+            out,
+            "wrote {} ({} frames, {:.1} kB, {:.2} s)",
+            w.path.display(),
+            w.frames,
+            w.bytes as f64 / 1024.0,
+            w.seconds
+        )
+        .map_err(stdout_err)?;
+    }
     Ok(())
+}
+
+/// The run `animate` draws and its title: an FMU or a scene is run here (its scene then added
+/// to `scenes` when none was given), anything else read as a CSV.
+fn animate_recording(
+    run: &Path,
+    stop: Option<f64>,
+    step: Option<f64>,
+    scenes: &mut Vec<animate::KnownScene>,
+) -> Result<(animate::Recording, String), HarnessError> {
+    let ext = run.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let stem = run
+        .file_stem()
+        .map_or("run".into(), |s| s.to_string_lossy().to_string());
+    Ok(match ext {
+        "fmu" => {
+            let (rec, packaged) = animate::run_fmu(run, stop, step)?;
+            if let (Some(s), true) = (packaged, scenes.is_empty()) {
+                scenes.push(animate::KnownScene {
+                    prefix: String::new(),
+                    scene: s,
+                });
+            }
+            (rec, stem)
+        }
+        "toml" => {
+            let s = fmu_beam::Scene::load(run)?;
+            let rec = animate::run_scene(&s, &run.display().to_string(), stop, step)?;
+            let name = s.name.clone();
+            if scenes.is_empty() {
+                scenes.push(animate::KnownScene {
+                    prefix: String::new(),
+                    scene: s,
+                });
+            }
+            (rec, name)
+        }
+        _ => (animate::read_csv(run)?, stem),
+    })
+}
+
+/// `explain`: the scene's effects, why, and their share of the cost.
+fn explain_cmd(scene: &Path, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let scene = fmu_beam::Scene::load(scene)?;
+    let text = fmu_beam::resolve_effects(&scene).explain(&scene);
+    out.write_all(text.as_bytes()).map_err(stdout_err)
+}
+
+/// `modes`: the first `count` elastic natural frequencies.
+fn modes_cmd(scene: &Path, count: usize, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let f = modes::elastic_frequencies(scene)?;
+    out.write_all(modes::report(&f, count).as_bytes())
+        .map_err(stdout_err)
 }
 
 /// `WIDTHxHEIGHT` in pixels.
@@ -340,16 +434,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), HarnessError> {
 }
 
 /// Writes generated text to a file, or to `out`.
-fn write_text(
-    text: &str,
-    path: Option<&std::path::Path>,
-    out: &mut dyn Write,
-) -> Result<(), HarnessError> {
+fn write_text(text: &str, path: Option<&Path>, out: &mut dyn Write) -> Result<(), HarnessError> {
     match path {
         Some(p) => std::fs::write(p, text)
             .map_err(|e| HarnessError::io(p, "writing the generated file", e)),
-        None => out
-            .write_all(text.as_bytes())
-            .map_err(|e| HarnessError::io("<stdout>", "writing the report", e)),
+        None => out.write_all(text.as_bytes()).map_err(stdout_err),
     }
 }

@@ -1,46 +1,43 @@
-//! The raw FMI 2.0 co-simulation binding: the C types and function pointer types of
-//! `fmi2TypesPlatform.h` / `fmi2FunctionTypes.h` that the master uses, loaded with `libloading`
-//! from `binaries/linux64/<modelIdentifier>.so`, and an [`Instance`] whose methods call them one
-//! to one (slices instead of pointer + length, status as [`Status`]).
+//! The raw FMI 2.0 co-simulation binding: the function pointer types of `fmi2FunctionTypes.h`
+//! that the master uses, loaded with `libloading` from `binaries/linux64/<modelIdentifier>.so`,
+//! and an [`Instance`] whose methods call them one to one (slices instead of pointer + length,
+//! status as [`Status`]). The C types of `fmi2TypesPlatform.h` are the unit's, shared:
+//! [`fmu_beam::fmi2_types`]; the master differs from the unit only where it receives: a status
+//! as a plain `c_int` ([`RawStatus`]) and a logger without the variadic tail.
 //!
 //! The one module of fmu-harness with unsafe code. What it guarantees to the safe code above it:
 //! an [`Instance`] owns its component, its callback struct and its log sink, which outlive every
 //! call and are freed after `fmi2FreeInstance`; the library stays loaded while an instance lives;
 //! array lengths passed to C are the slice lengths; an [`FmuState`] is only ever handed back to
 //! the instance that made it.
+//!
+//! Over 600 lines on purpose: all of the crate's unsafe code, in one file to be reviewed as one.
 
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
+pub use fmu_beam::fmi2_types::{
+    fmi2Boolean, fmi2CallbackAllocateMemory, fmi2CallbackFreeMemory, fmi2CoSimulation,
+    fmi2Component, fmi2ComponentEnvironment, fmi2FMUstate, fmi2False, fmi2Integer, fmi2Real,
+    fmi2StepFinished, fmi2String, fmi2True, fmi2Type, fmi2ValueReference,
+};
 use std::ffi::CStr;
-use std::os::raw::{c_char, c_int, c_uint, c_void};
+use std::os::raw::{c_int, c_void};
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-pub type fmi2Component = *mut c_void;
-pub type fmi2ComponentEnvironment = *mut c_void;
-pub type fmi2FMUstate = *mut c_void;
-pub type fmi2ValueReference = c_uint;
-pub type fmi2Real = f64;
-pub type fmi2Integer = c_int;
-pub type fmi2Boolean = c_int;
-pub type fmi2String = *const c_char;
-pub type fmi2Status = c_int;
-pub type fmi2Type = c_int;
-
-pub const fmi2True: fmi2Boolean = 1;
-pub const fmi2False: fmi2Boolean = 0;
-pub const fmi2CoSimulation: fmi2Type = 1;
+/// `fmi2Status` as the master receives it: a plain `c_int`, not the unit's `fmi2Status` enum of
+/// [`fmu_beam::fmi2_types`] (a Rust enum must never hold a value outside its variants, and a
+/// foreign FMU may return any integer); [`Status::from_c`] reads it.
+pub type RawStatus = c_int;
 
 /// `fmi2CallbackLogger` without its variadic tail. C declares it `(env, name, status, category,
 /// message, ...)`; a stable Rust `extern "C" fn` cannot be variadic, so the master's logger takes
 /// the fixed arguments only and `message` is shown as it comes. Our FMUs double every `%`, so
 /// their messages carry no directives; a foreign FMU's printf-style arguments are not expanded
-/// (the message keeps its `%d`, `%s`, ...).
+/// (the message keeps its `%d`, `%s`, ...). Hence the master's own logger type and callback
+/// struct, of the same layout as [`fmu_beam::fmi2_types::fmi2CallbackFunctions`] (checked below).
 pub type fmi2CallbackLogger =
-    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
-pub type fmi2CallbackAllocateMemory = unsafe extern "C" fn(usize, usize) -> *mut c_void;
-pub type fmi2CallbackFreeMemory = unsafe extern "C" fn(*mut c_void);
-pub type fmi2StepFinished = unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status);
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, RawStatus, fmi2String, fmi2String);
 
 /// `fmi2CallbackFunctions`.
 #[repr(C)]
@@ -51,6 +48,20 @@ pub struct fmi2CallbackFunctions {
     pub stepFinished: Option<fmi2StepFinished>,
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
+
+// The callback struct the FMU reads has the layout of the one it declares.
+const _: () = {
+    use fmu_beam::fmi2_types::fmi2CallbackFunctions as Declared;
+    use std::mem::{align_of, offset_of, size_of};
+    type Ours = fmi2CallbackFunctions;
+    assert!(size_of::<Ours>() == size_of::<Declared>());
+    assert!(align_of::<Ours>() == align_of::<Declared>());
+    assert!(offset_of!(Ours, logger) == offset_of!(Declared, logger));
+    assert!(offset_of!(Ours, allocateMemory) == offset_of!(Declared, allocateMemory));
+    assert!(offset_of!(Ours, freeMemory) == offset_of!(Declared, freeMemory));
+    assert!(offset_of!(Ours, stepFinished) == offset_of!(Declared, stepFinished));
+    assert!(offset_of!(Ours, componentEnvironment) == offset_of!(Declared, componentEnvironment));
+};
 
 pub type fmi2InstantiateTYPE = unsafe extern "C" fn(
     fmi2String,
@@ -69,58 +80,57 @@ pub type fmi2SetupExperimentTYPE = unsafe extern "C" fn(
     fmi2Real,
     fmi2Boolean,
     fmi2Real,
-) -> fmi2Status;
-pub type fmi2EnterInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
-pub type fmi2ExitInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
-pub type fmi2TerminateTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
-pub type fmi2ResetTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+) -> RawStatus;
+pub type fmi2EnterInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> RawStatus;
+pub type fmi2ExitInitializationModeTYPE = unsafe extern "C" fn(fmi2Component) -> RawStatus;
+pub type fmi2TerminateTYPE = unsafe extern "C" fn(fmi2Component) -> RawStatus;
+pub type fmi2ResetTYPE = unsafe extern "C" fn(fmi2Component) -> RawStatus;
 pub type fmi2GetRealTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *mut fmi2Real,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2GetIntegerTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *mut fmi2Integer,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2GetBooleanTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *mut fmi2Boolean,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2SetRealTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *const fmi2Real,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2SetIntegerTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *const fmi2Integer,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2SetBooleanTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *const fmi2Boolean,
-) -> fmi2Status;
-pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
-pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status;
-pub type fmi2FreeFMUstateTYPE =
-    unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+) -> RawStatus;
+pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
+pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> RawStatus;
+pub type fmi2FreeFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
 pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
     usize,
     *const fmi2Integer,
     *const fmi2Real,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
@@ -129,9 +139,9 @@ pub type fmi2GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
     usize,
     *const fmi2Real,
     *mut fmi2Real,
-) -> fmi2Status;
+) -> RawStatus;
 pub type fmi2DoStepTYPE =
-    unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
+    unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> RawStatus;
 
 extern "C" {
     fn calloc(nobj: usize, size: usize) -> *mut c_void;
@@ -151,7 +161,7 @@ pub enum Status {
 }
 
 impl Status {
-    pub fn from_c(s: fmi2Status) -> Self {
+    pub fn from_c(s: RawStatus) -> Self {
         match s {
             0 => Status::Ok,
             1 => Status::Warning,
@@ -207,7 +217,7 @@ pub type LogSink = Mutex<Vec<LogMessage>>;
 unsafe extern "C" fn log_message(
     env: fmi2ComponentEnvironment,
     _instance_name: fmi2String,
-    status: fmi2Status,
+    status: RawStatus,
     category: fmi2String,
     message: fmi2String,
 ) {

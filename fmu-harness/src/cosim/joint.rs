@@ -35,8 +35,10 @@
 //! - Broyden, C. G. (1965): A class of methods for solving nonlinear simultaneous equations.
 //!   Math. Comp. 19(92).
 
+use super::attempt::Refused;
+use super::step_control::restore;
 use super::system::{CouplingSpec, JointSpec};
-use super::{restore, CosimError, Refused, Unit};
+use super::{CosimError, Unit};
 use crate::slave::{Causality, VarType};
 use nalgebra::{DMatrix, DVector};
 use std::path::Path;
