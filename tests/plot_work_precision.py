@@ -1,4 +1,4 @@
-"""Work-precision charts of `fmu-harness work-precision` (run by `make bench`): per case, the
+"""Work-precision charts of `fmu-bench work-precision` (run by `make bench`): per case, the
 relative error of its main output against the CPU time of one run, log-log, one colour per
 formulation (circles and solid lines: error control over the tolerance; squares and dashed
 lines: fixed step). Reads build/bench/points.csv, writes build/bench/<case>.png; with

@@ -49,7 +49,7 @@ GRID = {
     'c4_omega10': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                    ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
     # the meshes between the doublings (12, 24) where the 1e-5 target is decided, as our
-    # substructure counts 15 and 30 (fmu-harness/src/work_precision/peer.rs)
+    # substructure counts 15 and 30 (bench/src/work_precision/peer.rs)
     'c4_omega4': [((2, 4, 8, 12, 16, 24, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                   ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
 }
