@@ -1,6 +1,11 @@
 //! Generalized-α for index-3 constrained mechanical systems, with Newton iterations on the
 //! position correction, scaling of the iteration matrix, and local error control.
 //!
+//! Here: the state, the coefficients, the [`Stepper`] and its step loop ([`Stepper::advance`]:
+//! landing on communication points and law jumps, splits, retries; one method of about 200
+//! lines, the loop read as one). One step's Newton iterations are in `newton_step`, the error
+//! estimate and the step-size controller in `error_control`.
+//!
 //! # References
 //! - J. Chung, G. M. Hulbert (1993), A time integration algorithm for structural dynamics with
 //!   improved numerical dissipation: the generalized-α method. J. Appl. Mech. 60, 371–375.
@@ -16,6 +21,12 @@ use super::{Settings, Stats};
 use crate::error::EngineError;
 use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
 use nalgebra::DVector;
+
+mod error_control;
+mod newton_step;
+
+pub use error_control::Controller;
+
 
 /// The integration state at a step boundary.
 #[derive(Debug, PartialEq)]
@@ -205,29 +216,6 @@ const LAND: f64 = 1e-6;
 /// A remainder this short (relative to the step) before a landing point takes no implicit step.
 const TINY: f64 = 1e-6;
 
-/// A step-size factor rounded down to a multiple of 1/64. The factor is a power of the error
-/// estimate, and libm's `pow` may round the last bit differently on another platform: rounded,
-/// the step sizes (and with them every decision that follows) are the same bit for bit unless
-/// the factor lies within a last bit of a multiple.
-fn quantized(factor: f64) -> f64 {
-    let q = (factor * 64.0).floor() / 64.0;
-    if q > 0.0 {
-        q
-    } else {
-        factor
-    }
-}
-
-/// The factor on the step size after an accepted step whose controller proposes `grow`.
-fn step_factor(grow: f64) -> f64 {
-    let grow = grow.clamp(0.2, MAX_GROWTH);
-    if (1.0..=KEEP_STEP).contains(&grow) {
-        1.0
-    } else {
-        grow
-    }
-}
-
 /// Where the factorized iteration matrix was evaluated. The factors are not stored: a restored
 /// state factorizes the matrix again at this point, so that it continues bit for bit.
 #[derive(Debug, Clone, PartialEq)]
@@ -261,51 +249,6 @@ pub struct Memory {
     /// newest (the current state) last, at most [`HISTORY`]: the local error estimate is the
     /// third divided difference of these and the step's end ([`Stepper::attempt`]).
     pub history: Vec<(f64, DVector<f64>)>,
-}
-
-/// The step-size controller's memory.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Controller {
-    /// Error norms of the last accepted steps (at most [`RECENT`], the newest last); a rejected
-    /// step clears them.
-    pub recent: Vec<f64>,
-    /// A cap on the step size after Newton's iteration diverged with a fresh matrix, and the
-    /// accepted steps it still holds for.
-    pub cap: Option<(f64, u32)>,
-}
-
-impl Controller {
-    /// The step after an accepted one of size `h` and error norm `err`.
-    fn accepted(&mut self, h: f64, err: f64) -> f64 {
-        if self.recent.len() == RECENT {
-            self.recent.remove(0);
-        }
-        self.recent.push(err);
-        let worst = self.recent.iter().copied().fold(0.0, f64::max);
-        let grow = if worst > 0.0 {
-            0.9 * worst.powf(-1.0 / 3.0)
-        } else {
-            MAX_GROWTH
-        };
-        let mut next = h * quantized(step_factor(grow));
-        if let Some((cap, left)) = self.cap {
-            next = next.min(cap);
-            self.cap = (left > 1).then_some((cap, left - 1));
-        }
-        next
-    }
-
-    /// The step after a rejected one of size `h` and error norm `err`.
-    fn rejected(&mut self, h: f64, err: f64) -> f64 {
-        self.recent.clear();
-        h * quantized((0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0))
-    }
-
-    /// Newton's iteration diverged with a fresh matrix at step `h`.
-    fn newton_failed(&mut self, h: f64) {
-        self.recent.clear();
-        self.cap = Some((NEWTON_CAP * h, NEWTON_CAP_STEPS));
-    }
 }
 
 /// Why a fixed step was cut short.
@@ -477,88 +420,6 @@ impl Stepper {
         initial::meet_jump(sys, st, before, after, h, w)?;
         self.restarted();
         Ok(())
-    }
-
-    /// Appends the end (t1, q1) of an accepted step from (t0, q0) to the history of positions,
-    /// which starts again at t0 where it does not end there.
-    fn remember(&mut self, t0: f64, q0: &DVector<f64>, t1: f64, q1: &DVector<f64>) {
-        let history = &mut self.memory.history;
-        if history.last().map(|p| p.0) != Some(t0) {
-            history.clear();
-            history.push((t0, q0.clone()));
-        }
-        if history.len() == HISTORY {
-            // the oldest point's vector is reused: no allocation per step
-            let (_, mut q) = history.remove(0);
-            q.copy_from(q1);
-            history.push((t1, q));
-        } else {
-            history.push((t1, q1.clone()));
-        }
-    }
-
-    /// The local error of a step from `st` to (t1, q1) per coordinate, |β − 1/6| h³ q''', with
-    /// q''' from the third divided difference of the positions at the last [`HISTORY`] points
-    /// and the step's end. Where the history does not reach back that far (the first two steps
-    /// after the start or a restart), the state at the step's start enters as a repeated node
-    /// with its velocity (and, at the restart point itself, its acceleration): a cubic through
-    /// the positions and derivatives since the restart, none from before it.
-    ///
-    /// Why positions, not the algorithmic accelerations' change (β − 1/6) h² Δa of Géradin and
-    /// Cardona: both estimate the same h³ q''' where the motion is resolved, but a mode of
-    /// frequency ω and amplitude A that the step does not resolve (ωh ≫ 1) weighs ω²h²A in
-    /// Δa, and at most 8A in a third difference. A load's jump rings every mode of a mesh, each
-    /// with an amplitude about its share of the static deflection, 1/ω²: in Δa the mesh's
-    /// highest modes lead, and an error-controlled run resolved them at their own time scale.
-    /// With positions a mode is resolved only where its amplitude matters at the tolerance,
-    /// and ρ∞ damps the rest, as at fixed steps (C3's elastic crank after its torque's cut-off).
-    /// The velocity and the acceleration at a restart stay bounded by the positions' scale on
-    /// such a mode (h q' and h² q'' of order A: the jump is met through the iteration matrix,
-    /// [`initial::meet_jump`]), so the first steps after it are estimated on the same footing.
-    fn position_error(
-        &self,
-        st: &GaState,
-        t1: f64,
-        q1: &DVector<f64>,
-        c: &Coefficients,
-    ) -> DVector<f64> {
-        let history = self.memory.history.as_slice();
-        // the points before the step's start, where the history ends there
-        let earlier = match history.split_last() {
-            Some((last, rest)) if last.0 == st.t && rest.iter().all(|p| p.1.len() == q1.len()) => {
-                rest
-            }
-            _ => &[],
-        };
-        let h = t1 - st.t;
-        let factor = (c.beta - 1.0 / 6.0).abs() * 6.0 * h * h * h;
-        let tc = st.t;
-        DVector::from_fn(q1.len(), |k, _| {
-            let (qc, q) = (st.q[k], q1[k]);
-            factor
-                * match earlier {
-                    [(ta, a), (tb, b)] => third_difference([*ta, *tb, tc, t1], [a[k], b[k], qc, q]),
-                    [(tb, b)] => {
-                        third_difference_with_velocity([*tb, tc, t1], [b[k], qc, q], st.v[k])
-                    }
-                    _ => third_difference_with_acceleration([tc, t1], [qc, q], st.v[k], st.qdd[k]),
-                }
-        })
-    }
-
-    /// Weighted RMS norm of a position-like vector against the tolerance.
-    fn norm<'a>(&self, dq: impl Iterator<Item = &'a f64>, q: &DVector<f64>) -> f64 {
-        let tol = self.settings.tolerance;
-        let n = q.len().max(1) as f64;
-        let s: f64 = dq
-            .zip(q.iter())
-            .zip(self.scale.iter())
-            .map(|((d, x), sc)| {
-                let w = tol * (x.abs() + sc);
-                (d / w) * (d / w)
-            })
-            .sum();
-        (s / n).sqrt()
     }
 
     /// Integrates `st` to exactly `t_end`, in internal steps.
@@ -810,312 +671,19 @@ impl Stepper {
         }
     }
 
-    /// Builds and factorizes the scaled iteration matrix at a point.
-    #[allow(clippy::too_many_arguments)]
-    fn factorize<S: Equations + ?Sized>(
-        &mut self,
-        sys: &S,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        qdd: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        h: f64,
-        c: &Coefficients,
-    ) -> bool {
-        self.matrix
-            .factorize(sys, q, v, qdd, lambda, t, c.scaling(h))
-    }
-
-    /// Solves for the Newton correction at iterate `q` in `rhs`. Where the bodies have turned
-    /// since the matrix was factorized, by angles δ_b, the matrix is used as if turned by the
-    /// middle of their range ([`Turning`]): a matrix of a spinning or swinging system stays a
-    /// good one over many steps, and no body's mismatch exceeds what it was unturned.
-    fn solve_turned(&mut self, q: &DVector<f64>) -> bool {
-        let (Some(delta), Some(turning)) = (self.turned(q), &self.turning) else {
-            return self.matrix.solve_mut(&mut self.rhs);
-        };
-        turn_pairs(&mut self.rhs, &turning.pairs, -delta);
-        let solved = self.matrix.solve_mut(&mut self.rhs);
-        turn_pairs(&mut self.rhs, &turning.pairs, delta);
-        solved
-    }
-
-    /// The angle δ by which the matrix is used as turned at iterate `q` (the middle of the
-    /// range of the bodies' turns since it was factorized), where it is not zero.
-    fn turned(&self, q: &DVector<f64>) -> Option<f64> {
-        let (Some(turning), Some(p)) = (&self.turning, &self.memory.point) else {
-            return None;
-        };
-        let (lo, hi) = turning
-            .angles
-            .iter()
-            .map(|&k| q[k] - p.q[k])
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
-                (lo.min(d), hi.max(d))
-            });
-        // no bodies: ∞ - ∞, not finite
-        let delta = 0.5 * (lo + hi);
-        (delta != 0.0 && delta.is_finite()).then_some(delta)
-    }
-
-    /// The norm of the step's local error: that of the positions' estimate
-    /// ([`Stepper::position_error`]), and where it refuses the step under ρ∞ < 1, that of the
-    /// estimate filtered by the scheme's damping ([`Stepper::filtered`]) if smaller.
-    fn error_norm(&mut self, st: &GaState, t1: f64, q1: &DVector<f64>, c: &Coefficients) -> f64 {
-        let e = self.position_error(st, t1, q1, c);
-        let raw = self.norm(e.iter(), q1);
-        if raw <= 1.0 || self.settings.rho_inf >= 1.0 {
-            return raw;
-        }
-        self.filtered(e, q1)
-            .map_or(raw, |f| raw.min(self.norm(f.iter(), q1)))
-    }
-
-    /// The position error `e` of a step ending at `q1`, filtered [`FILTER_PASSES`] times by
-    /// the step's iteration matrix ([`IterationMatrix::filter`], turned as the Newton
-    /// corrections are). With S = c_m M + d K_t + c_c C_t (d = βh², c_m = (1 − α_m)/(1 − α_f))
-    /// each pass keeps the motion the step resolves (ωh ≪ 1) and multiplies a mode of
-    /// frequency ω by 1/(1 + β'(ωh)²), β' = β(1 − α_f)/(1 − α_m) (0.27 at ρ∞ = 0.7): the
-    /// modes generalized-α with ρ∞ < 1 damps instead of following. Their raw estimate stays
-    /// up to 8|β − 1/6| × their amplitude however long the step (the third difference of an
-    /// oscillation), so a step that lets ρ∞ damp a mode its jump struck, as a fixed step
-    /// does, was refused for it while the mode lasted, and steps shrank until they resolved
-    /// it: C3's elastic crank at tolerance 1e-5 took 1 368 steps, 1 200 of them after the
-    /// torque's cut-off, to end 4.1e-4 off where the fixed 4e-3 s step (400) ends 1.9e-4 off.
-    /// Filtered twice, such a mode's estimate falls as (ωh)⁻⁴: 183 steps, 6.9e-4 (issue 12,
-    /// item 5; docs/accuracy.md). None when the matrix cannot solve.
-    fn filtered(&mut self, mut e: DVector<f64>, q1: &DVector<f64>) -> Option<DVector<f64>> {
-        let delta = self.turned(q1);
-        if let (Some(d), Some(t)) = (delta, &self.turning) {
-            turn_pairs(&mut e, &t.pairs, -d);
-        }
-        for _ in 0..FILTER_PASSES {
-            if !self.matrix.filter(&mut e, &mut self.rhs) {
-                return None;
-            }
-        }
-        if let (Some(d), Some(t)) = (delta, &self.turning) {
-            turn_pairs(&mut e, &t.pairs, d);
-        }
-        Some(e)
-    }
-
     /// Whether the iteration matrix is factorized sparse.
     pub fn is_sparse(&self) -> bool {
         self.matrix.is_sparse()
     }
 
-    /// One step of size h from `st`; returns the new state and the local error norm.
-    fn attempt<S: Equations + ?Sized>(
-        &mut self,
-        sys: &S,
-        st: &GaState,
-        stats: &mut Stats,
-        h: f64,
-        t_new: f64,
-    ) -> Result<(GaState, f64), Failure> {
-        let c = Coefficients::new(self.settings.rho_inf);
-        let (n, m) = (sys.n(), sys.m());
-        let d = c.beta * h * h;
-        let beta_p = (1.0 - c.alpha_m) / (d * (1.0 - c.alpha_f));
-        let gamma_p = c.gamma / (c.beta * h);
-        if self
-            .memory
-            .point
-            .as_ref()
-            .is_some_and(|p| (h - p.h).abs() > SAME_STEP * h)
-        {
-            self.forget();
-        }
-        // a restored state: the same factors, at the same point
-        if !self.matrix.is_factored() {
-            if let Some(p) = self.memory.point.take() {
-                if !self.factorize(sys, &p.q, &p.v, &p.qdd, &p.lambda, p.t, p.h, &c) {
-                    self.forget();
-                    return Err(Failure::Singular);
-                }
-                self.memory.point = Some(p);
-            }
-        }
-        // predictor: q''_{n+1} = q''_n
-        let mut qdd = st.qdd.clone();
-        let acc_new = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m + &qdd * (1.0 - c.alpha_f))
-            / (1.0 - c.alpha_m);
-        let mut v = &st.v + &st.acc * (h * (1.0 - c.gamma)) + &acc_new * (h * c.gamma);
-        let mut q = &st.q + &st.v * h + &st.acc * (h * h * (0.5 - c.beta)) + &acc_new * d;
-        let mut lambda = st.lambda.clone();
-        let mut fresh = false;
-        let mut prev = f64::INFINITY;
-        let mut norm = f64::INFINITY;
-        let mut iterations = 0;
-        // corrections since the matrix was factorized, and refactorizations within this step
-        let (mut k, mut refreshed) = (0, 0);
-        let tol = self.settings.tolerance;
-        let floor_of = |noise: f64| ROUNDING.max(NOISE_BAND * noise * f64::EPSILON) / tol;
-        let mut floor = floor_of(self.memory.noise);
-        // Newton's error bound: κ of the tolerance, and at most the tolerance's share of the
-        // step's own increment, so that it cannot pile up over many small steps (summed over a
-        // run it stays below tol × the path the coordinates travel)
-        let increment = self.norm((&q - &st.q).iter(), &q);
-        let kappa = KAPPA.min(INCREMENT_SHARE * self.settings.tolerance * increment);
-        for it in 0..MAX_NEWTON {
-            if !self.matrix.is_factored() {
-                if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c) {
-                    self.forget();
-                    return Err(Failure::Singular);
-                }
-                stats.jacobians += 1;
-                // a new matrix: its point, and a rate not yet measured (the grid, the
-                // controller and the noise level are the run's, not the matrix's)
-                self.memory.point = Some(MatrixPoint {
-                    q: q.clone(),
-                    v: v.clone(),
-                    qdd: qdd.clone(),
-                    lambda: lambda.clone(),
-                    t: t_new,
-                    h,
-                });
-                self.memory.contraction.fresh();
-                fresh = true;
-                k = 0;
-                prev = f64::INFINITY;
-            }
-            sys.body_residual(&q, &v, &qdd, t_new, &mut self.r);
-            sys.constraints_and_rows(&q, t_new, &mut self.g, &mut self.gm);
-            self.gm.add_transpose_times(&lambda, &mut self.r);
-            for i in 0..n {
-                self.rhs[i] = -d * self.r[i];
-            }
-            for k in 0..m {
-                self.rhs[n + k] = -self.g[k];
-            }
-            if !self.solve_turned(&q) {
-                self.forget();
-                return Err(Failure::Singular);
-            }
-            stats.newton_iterations += 1;
-            iterations += 1;
-            let dq = self.rhs.rows(0, n);
-            q += dq;
-            v.axpy(gamma_p, &dq, 1.0);
-            qdd.axpy(beta_p, &dq, 1.0);
-            for k in 0..m {
-                lambda[k] += self.rhs[n + k] / d;
-            }
-            if !dq.iter().all(|x| x.is_finite()) || !q.iter().all(|x| x.is_finite()) {
-                self.forget();
-                return Err(Failure::NonFinite);
-            }
-            norm = self.norm(dq.iter(), &q);
-            let ratio = norm / prev;
-            let size = norm * tol / f64::EPSILON;
-            if fresh
-                && k >= 1
-                && size <= NOISE_CEILING
-                && (ratio > NOISE_STAGNANT || (ratio > NOISE_RATIO && size <= NOISE_SMALL))
-            {
-                self.memory.noise = size;
-                floor = floor_of(self.memory.noise);
-            }
-            let verdict = self.memory.contraction.judge(
-                k,
-                norm,
-                prev,
-                floor,
-                MAX_NEWTON - 1 - it,
-                kappa,
-                fresh,
-            );
-            k += 1;
-            match verdict {
-                Verdict::Converged => {
-                    let mut acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m
-                        + &qdd * (1.0 - c.alpha_f))
-                        / (1.0 - c.alpha_m);
-                    // coordinates of massless bodies are algebraic: their accelerations enter
-                    // no equation, and the scheme's recurrence would let them grow without bound
-                    for &k in &self.algebraic {
-                        acc[k] = 0.0;
-                        qdd[k] = 0.0;
-                    }
-                    let err = if self.settings.adaptive {
-                        self.error_norm(st, t_new, &q, &c)
-                    } else {
-                        0.0
-                    };
-                    let stale = if self.turning.is_some() {
-                        STALE_TURNED
-                    } else {
-                        STALE
-                    };
-                    if self.memory.contraction.slow(stale) {
-                        self.forget(); // slow: a new matrix for the next step
-                    }
-                    return Ok((
-                        GaState {
-                            t: st.t,
-                            h: st.h,
-                            q,
-                            v,
-                            acc,
-                            qdd,
-                            lambda,
-                            work: st.work,
-                        },
-                        err,
-                    ));
-                }
-                Verdict::Continue => {
-                    prev = norm;
-                    // a matrix that contracts slowly (it was evaluated at a predictor far from
-                    // the solution, or steps ago) is evaluated again at the current iterate,
-                    // close to the solution: Newton's own quadratic convergence
-                    if self.memory.contraction.stalls() && k > 2 && refreshed < MAX_REFRESH {
-                        self.matrix.forget();
-                        refreshed += 1;
-                    }
-                }
-                Verdict::Diverging => break,
-            }
-        }
-        self.forget();
-        Err(Failure::Newton {
-            iterations,
-            correction: norm,
-            fresh,
-        })
-    }
 }
 
-/// The third divided difference q[t0, t1, t2, t3] of four values at increasing times: q'''/6
-/// somewhere in [t0, t3] for a smooth q.
-fn third_difference(t: [f64; 4], q: [f64; 4]) -> f64 {
-    let first = |i: usize, j: usize, a: f64, b: f64| (b - a) / (t[j] - t[i]);
-    let (s01, s12, s23) = (
-        first(0, 1, q[0], q[1]),
-        first(1, 2, q[1], q[2]),
-        first(2, 3, q[2], q[3]),
-    );
-    let (s012, s123) = (first(0, 2, s01, s12), first(1, 3, s12, s23));
-    first(0, 3, s012, s123)
-}
-
-/// The third divided difference q[t0, t1, t1, t2] of values at three increasing times and the
-/// velocity at the middle one.
-fn third_difference_with_velocity(t: [f64; 3], q: [f64; 3], v1: f64) -> f64 {
-    let s01 = (q[1] - q[0]) / (t[1] - t[0]);
-    let s12 = (q[2] - q[1]) / (t[2] - t[1]);
-    let (s011, s112) = ((v1 - s01) / (t[1] - t[0]), (s12 - v1) / (t[2] - t[1]));
-    (s112 - s011) / (t[2] - t[0])
-}
-
-/// The third divided difference q[t0, t0, t0, t1] of values at two times and the velocity and
-/// acceleration at the first.
-fn third_difference_with_acceleration(t: [f64; 2], q: [f64; 2], v0: f64, a0: f64) -> f64 {
-    let h = t[1] - t[0];
-    let s001 = ((q[1] - q[0]) / h - v0) / h;
-    (s001 - 0.5 * a0) / h
+/// An explicit Taylor step of a length far below the step size (a remainder before a point to
+/// land on): q += h v + h²/2 q'', v += h q''; accelerations and multipliers kept.
+fn taylor(st: &mut GaState, h: f64) {
+    st.q.axpy(h, &st.v, 1.0);
+    st.q.axpy(0.5 * h * h, &st.qdd, 1.0);
+    st.v.axpy(h, &st.qdd, 1.0);
 }
 
 /// Turns each (x, y) pair of `x` starting at the given indices by the angle δ.
@@ -1127,83 +695,5 @@ fn turn_pairs(x: &mut DVector<f64>, pairs: &[usize], delta: f64) {
         let (a, b) = (x[i], x[i + 1]);
         x[i] = c * a - s * b;
         x[i + 1] = s * a + c * b;
-    }
-}
-
-/// An explicit Taylor step of a length far below the step size (a remainder before a point to
-/// land on): q += h v + h²/2 q'', v += h q''; accelerations and multipliers kept.
-fn taylor(st: &mut GaState, h: f64) {
-    st.q.axpy(h, &st.v, 1.0);
-    st.q.axpy(0.5 * h * h, &st.qdd, 1.0);
-    st.v.axpy(h, &st.qdd, 1.0);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// One low error among higher ones (an oscillation's estimate at a lucky phase) does not
-    /// grow the step; the step grows once the higher ones have left the window.
-    #[test]
-    fn the_step_grows_on_the_largest_recent_error() {
-        let mut c = Controller::default();
-        assert_eq!(c.accepted(1.0, 1e-6), MAX_GROWTH);
-        let after_high = c.accepted(1.0, 0.9);
-        assert!(after_high < 1.0, "{after_high}");
-        for _ in 1..RECENT {
-            assert_eq!(c.accepted(1.0, 1e-3), after_high);
-        }
-        assert_eq!(c.accepted(1.0, 1e-3), 9.0f64.min(MAX_GROWTH));
-        // a rejection forgets the errors before it
-        assert!(c.rejected(1.0, 8.0) < 0.5);
-        assert!(c.recent.is_empty());
-        assert_eq!(c.accepted(1.0, 1e-6), MAX_GROWTH);
-    }
-
-    /// The position-level estimate is exact for a cubic at any step sizes, and bounded by the
-    /// amplitude of a mode the steps do not resolve, where the change of the algorithmic
-    /// acceleration grows as ω²h².
-    #[test]
-    fn the_third_difference_finds_a_cubic_and_stays_bounded_on_an_unresolved_mode() {
-        let diff = |f: &dyn Fn(f64) -> f64, t: [f64; 4]| third_difference(t, t.map(f));
-        // q''' = 9 of a cubic, from unequal steps
-        let cubic = |t: f64| 2.0 - t + 0.5 * t * t + 1.5 * t * t * t;
-        assert!((6.0 * diff(&cubic, [0.1, 0.13, 0.2, 0.45]) - 9.0).abs() < 1e-11);
-        // a mode of amplitude 1 at ωh = 50 over equal steps h: h³ q''' estimated as the third
-        // difference of four values within ±1, at most 8, where the acceleration changes by
-        // up to 2 ω²h² = 5000
-        let (omega, h) = (5e4, 1e-3);
-        let t = [0.3, 0.3 + h, 0.3 + 2.0 * h, 0.3 + 3.0 * h];
-        let estimate = 6.0 * h * h * h * diff(&|t: f64| (omega * t).cos(), t);
-        assert!(estimate.abs() <= 8.0 + 1e-9, "{estimate}");
-    }
-
-    /// The first two steps after a restart take the restart point's derivatives as repeated
-    /// nodes: both find a cubic's q''' from unequal steps.
-    #[test]
-    fn the_third_difference_with_derivatives_finds_a_cubic() {
-        let q = |t: f64| 2.0 - t + 0.5 * t * t + 1.5 * t * t * t;
-        let (v, a) = (|t: f64| -1.0 + t + 4.5 * t * t, |t: f64| 1.0 + 9.0 * t);
-        let with_v =
-            third_difference_with_velocity([0.1, 0.13, 0.2], [q(0.1), q(0.13), q(0.2)], v(0.13));
-        assert!((6.0 * with_v - 9.0).abs() < 1e-10, "{with_v}");
-        let with_a =
-            third_difference_with_acceleration([0.13, 0.2], [q(0.13), q(0.2)], v(0.13), a(0.13));
-        assert!((6.0 * with_a - 9.0).abs() < 1e-10, "{with_a}");
-    }
-
-    /// After Newton's iteration diverged at h, the steps stay below 0.9 h for
-    /// `NEWTON_CAP_STEPS` accepted steps, and are free after.
-    #[test]
-    fn a_newton_failure_caps_the_step_for_a_while() {
-        let mut c = Controller::default();
-        c.newton_failed(1.0);
-        let mut h = 0.25;
-        for _ in 0..NEWTON_CAP_STEPS {
-            h = c.accepted(h, 1e-6);
-            assert!(h <= NEWTON_CAP, "{h}");
-        }
-        assert_eq!(c.cap, None);
-        assert!(c.accepted(h, 1e-6) > 1.0);
     }
 }
