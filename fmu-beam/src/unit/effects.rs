@@ -17,6 +17,11 @@ use std::f64::consts::PI;
 
 pub use crate::scene::rules::EFFECTS;
 
+mod cost;
+mod explain;
+
+use cost::{coordinates, nodal_coordinates, shape_read_cost, step_cost};
+
 /// Modes a beam keeps when `auto` finds its response quasi-static.
 pub const AUTO_MODES: usize = 4;
 /// `auto`: a beam whose first bending frequency is this many times above the excitation
@@ -50,117 +55,6 @@ pub struct Resolution {
     pub mode: &'static str,
     pub effects: Effects,
     pub decisions: Vec<Decision>,
-}
-
-impl Resolution {
-    /// The explanation as text: one line per decision, then the cost model's total.
-    pub fn explain(&self, scene: &Scene) -> String {
-        let mut s = format!(
-            "Effects of scene '{}' (effects = {}):\n\n",
-            scene.name, self.mode
-        );
-        let w = self
-            .decisions
-            .iter()
-            .map(|d| d.effect.len() + d.subject.len() + 3)
-            .max()
-            .unwrap_or(10);
-        let ws = self
-            .decisions
-            .iter()
-            .map(|d| d.setting.len())
-            .max()
-            .unwrap_or(3);
-        s += &format!(
-            "{:<w$}  {:<ws$}  {:>6}  why\n",
-            "effect (subject)", "setting", "cost"
-        );
-        for d in &self.decisions {
-            let name = format!("{} ({})", d.effect, d.subject);
-            s += &format!(
-                "{name:<w$}  {:<ws$}  {:>5.1}%  {}\n",
-                d.setting,
-                100.0 * d.cost_share,
-                d.why
-            );
-        }
-        let spatial = self
-            .decisions
-            .iter()
-            .any(|d| d.effect == "formulation" && d.setting == "spatial");
-        s += &self.explain_shape(scene, spatial);
-        if spatial {
-            s += "\ncost: no operation-count model for the 3D element (shares shown as 0); \
-                  `make bench` measures the time.\n";
-            return s;
-        }
-        s += &format!(
-            "\ncost: the share of the operations of one step (residual, tangents, LU of the \
-             iteration matrix) that the effect adds, from an operation count of the resolved \
-             system ({} coordinates); `make bench` measures the time.\n",
-            coordinates(scene, &self.effects)
-        );
-        s
-    }
-}
-
-impl Resolution {
-    /// The shape outputs (`crate::unit::shape`): what each beam offers and what reading them costs.
-    fn explain_shape(&self, scene: &Scene, spatial: bool) -> String {
-        let coords = if scene.is_3d() { 3 } else { 2 };
-        let rows: Vec<(String, String, String)> = scene
-            .beams
-            .iter()
-            .zip(&self.effects.beams)
-            .map(|(b, e)| {
-                let n = crate::unit::shape::stations(b, e.rigid).len();
-                let setting = if n == 0 {
-                    "off".to_string()
-                } else {
-                    format!("{n} points, {} outputs", coords * (n + 1))
-                };
-                let cost = if n == 0 {
-                    "none".to_string()
-                } else if spatial {
-                    format!("{} point evaluations per read of all", coords * n)
-                } else {
-                    let total = step_cost(scene, &self.effects);
-                    format!(
-                        "reading all once: {:.2}% of an internal step",
-                        100.0 * shape_read_cost(b, e) / total
-                    )
-                };
-                (format!("shape ({})", b.name), setting, cost)
-            })
-            .collect();
-        if rows.is_empty() {
-            return String::new();
-        }
-        let w = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
-        let ws = rows.iter().map(|r| r.1.len()).max().unwrap_or(0);
-        let mut s = String::from(
-            "\noutputs computed only when read (a step that nobody reads them after costs nothing \
-             more); `shape_points` sets the points, 0 none:\n",
-        );
-        for (name, setting, cost) in rows {
-            s += &format!("{name:<w$}  {setting:<ws$}  {cost}\n");
-        }
-        s
-    }
-}
-
-/// Operations (the unit of [`step_cost`]) to read every shape output of beam `b` once: each
-/// coordinate read evaluates its point, S_p q_f over the frame's n_f coordinates, a rotation
-/// and a translation.
-fn shape_read_cost(b: &BeamSpec, e: &BeamEffects) -> f64 {
-    let nf = if e.rigid {
-        0
-    } else {
-        let nodal = nodal_coordinates(b, Scene::beam_layout(b).0, e.options.axial);
-        e.options.modes.map_or(nodal, |m| m.min(nodal))
-    };
-    let points = crate::unit::shape::stations(b, e.rigid).len() as f64;
-    2.0 * points * (2.0 * nf as f64 + 6.0)
 }
 
 /// First bending natural frequency (rad/s) of a beam alone: clamped–free for a tangent frame,
@@ -657,17 +551,6 @@ fn auto(scene: &Scene) -> Resolution {
     })
 }
 
-/// Deformation coordinates of one frame of beam `b` with `elements` elements.
-fn nodal_coordinates(b: &BeamSpec, elements: usize, axial: bool) -> usize {
-    let _ = b; // both frames (tangent, pinned) remove three nodal coordinates
-    let full = 3 * (elements + 1) - 3;
-    if axial {
-        full
-    } else {
-        full - elements // u of every node but the one the frame already removes
-    }
-}
-
 /// The decisions of resolved effects, with the cost of each one.
 fn finish(
     scene: &Scene,
@@ -761,81 +644,4 @@ fn finish(
 
 fn on_off(on: bool) -> String {
     if on { "on" } else { "off" }.into()
-}
-
-/// Number of coordinates of the resolved system.
-fn coordinates(scene: &Scene, effects: &Effects) -> usize {
-    frames(scene, effects)
-        .iter()
-        .map(|f| 3 + f.nf)
-        .sum::<usize>()
-        + 3 * scene.bodies.len()
-}
-
-/// One floating frame of the resolved system, for the cost model.
-struct FrameCost {
-    nf: usize,
-    elements: usize,
-    options: BeamOptions,
-}
-
-fn frames(scene: &Scene, effects: &Effects) -> Vec<FrameCost> {
-    let mut out = Vec::new();
-    for (b, e) in scene.beams.iter().zip(&effects.beams) {
-        let (elements, k) = Scene::beam_layout(b);
-        let k = if e.rigid { 1 } else { k };
-        let nf = if e.rigid {
-            0
-        } else {
-            let nodal = nodal_coordinates(b, elements, e.options.axial);
-            e.options.modes.map_or(nodal, |m| m.min(nodal))
-        };
-        for _ in 0..k {
-            out.push(FrameCost {
-                nf,
-                elements,
-                options: e.options,
-            });
-        }
-    }
-    out
-}
-
-/// Operation count of one step with ≈ 3 Newton iterations: residuals and tangents of every
-/// frame, and one LU of the iteration matrix (n + m unknowns).
-fn step_cost(scene: &Scene, effects: &Effects) -> f64 {
-    let mut ops = 0.0;
-    let mut n = 3.0 * scene.bodies.len() as f64;
-    for f in frames(scene, effects) {
-        let nf = f.nf as f64;
-        n += 3.0 + nf;
-        if f.nf == 0 {
-            ops += 60.0; // a rigid body's residual and tangents
-            continue;
-        }
-        // residual (×3) and tangents (×1): mass coupling and stiffness are always there
-        let mut per = 4.0 * nf * nf + 20.0 * nf;
-        if f.options.quadratic_velocity {
-            per += 3.0 * nf * nf;
-        }
-        if f.options.damping {
-            per += 2.0 * nf * nf;
-        }
-        if f.options.geometric_stiffening {
-            per += f.elements as f64 * 4.0 * 6.0 * 6.0 * 4.0;
-            if f.options.modes.is_some() {
-                per += 2.0 * nf * nf * nf; // projection of the tangent
-            }
-        }
-        if effects.gravity {
-            per += 4.0 * nf;
-        }
-        ops += per;
-    }
-    if effects.gravity {
-        ops += 10.0 * scene.bodies.len() as f64;
-    }
-    // joints: ≈ 3 equations per joint
-    let m = 3.0 * (scene.joints.len() + scene.beams.len()) as f64;
-    ops + (n + m).powi(3) / 3.0
 }

@@ -159,7 +159,13 @@ impl Stepper {
     /// The norm of the step's local error: that of the positions' estimate
     /// ([`Stepper::position_error`]), and where it refuses the step under ρ∞ < 1, that of the
     /// estimate filtered by the scheme's damping ([`Stepper::filtered`]) if smaller.
-    pub(super) fn error_norm(&mut self, st: &GaState, t1: f64, q1: &DVector<f64>, c: &Coefficients) -> f64 {
+    pub(super) fn error_norm(
+        &mut self,
+        st: &GaState,
+        t1: f64,
+        q1: &DVector<f64>,
+        c: &Coefficients,
+    ) -> f64 {
         let e = self.position_error(st, t1, q1, c);
         let raw = self.norm(e.iter(), q1);
         if raw <= 1.0 || self.settings.rho_inf >= 1.0 {
@@ -182,7 +188,11 @@ impl Stepper {
     /// torque's cut-off, to end 4.1e-4 off where the fixed 4e-3 s step (400) ends 1.9e-4 off.
     /// Filtered twice, such a mode's estimate falls as (ωh)⁻⁴: 183 steps, 6.9e-4 (issue 12,
     /// item 5; docs/accuracy.md). None when the matrix cannot solve.
-    pub(super) fn filtered(&mut self, mut e: DVector<f64>, q1: &DVector<f64>) -> Option<DVector<f64>> {
+    pub(super) fn filtered(
+        &mut self,
+        mut e: DVector<f64>,
+        q1: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
         let delta = self.turned(q1);
         if let (Some(d), Some(t)) = (delta, &self.turning) {
             turn_pairs(&mut e, &t.pairs, -d);
@@ -223,7 +233,12 @@ pub(super) fn third_difference_with_velocity(t: [f64; 3], q: [f64; 3], v1: f64) 
 
 /// The third divided difference q[t0, t0, t0, t1] of values at two times and the velocity and
 /// acceleration at the first.
-pub(super) fn third_difference_with_acceleration(t: [f64; 2], q: [f64; 2], v0: f64, a0: f64) -> f64 {
+pub(super) fn third_difference_with_acceleration(
+    t: [f64; 2],
+    q: [f64; 2],
+    v0: f64,
+    a0: f64,
+) -> f64 {
     let h = t[1] - t[0];
     let s001 = ((q[1] - q[0]) / h - v0) / h;
     (s001 - 0.5 * a0) / h

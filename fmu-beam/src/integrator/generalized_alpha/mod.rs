@@ -27,7 +27,6 @@ mod newton_step;
 
 pub use error_control::Controller;
 
-
 /// The integration state at a step boundary.
 #[derive(Debug, PartialEq)]
 pub struct GaState {
@@ -675,7 +674,6 @@ impl Stepper {
     pub fn is_sparse(&self) -> bool {
         self.matrix.is_sparse()
     }
-
 }
 
 /// An explicit Taylor step of a length far below the step size (a remainder before a point to

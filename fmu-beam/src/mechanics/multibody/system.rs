@@ -580,7 +580,6 @@ impl System {
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
     }
-
 }
 
 impl super::equations::Equations for System {
