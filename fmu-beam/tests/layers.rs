@@ -1,11 +1,14 @@
 //! The engine's layers import only downwards (ARCHITECTURE.md, "Layers"): every `crate::x`
 //! path in the code of a module (comments left out) names a module of its own layer or of one
-//! below it. Fails with the file, the line and the two layers.
+//! below it. Fails with the file, the line and the two layers. The element layer
+//! (`mechanics/beam/`: sections and finite elements) is the floor: it imports nothing, not even
+//! the scene format, so a newcomer can read it first.
 
 use std::path::{Path, PathBuf};
 
 /// The layers from the bottom up; a top-level module belongs to one of them.
-const LAYERS: [(&str, &[&str]); 7] = [
+const LAYERS: [(&str, &[&str]); 8] = [
+    ("elements", &["mechanics/beam"]),
     ("scene format", &["scene"]),
     ("errors", &["error"]),
     ("mechanics", &["mechanics"]),
@@ -37,7 +40,13 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 /// The top-level module a file of `src/` belongs to (`None` for lib.rs, the crate root).
 fn module_of(file: &Path) -> Option<String> {
     let rel = file.strip_prefix(src()).expect("below src");
-    let first = rel.components().next()?.as_os_str().to_str()?.to_string();
+    let mut parts = rel
+        .components()
+        .map(|c| c.as_os_str().to_str().unwrap_or(""));
+    let first = parts.next()?.to_string();
+    if first == "mechanics" && parts.next() == Some("beam") {
+        return Some("mechanics/beam".to_string());
+    }
     match first.strip_suffix(".rs") {
         Some("lib") => None,
         Some(m) => Some(m.to_string()),
@@ -55,11 +64,17 @@ fn crate_paths(code: &str) -> Vec<String> {
         if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
             continue; // `my_crate::`, not this crate
         }
+        // the module a path names: its first segment, or `mechanics/beam` for the element layer
         let ident = |s: &str| -> String {
-            s.trim_start()
+            let s = s.trim_start();
+            let first: String = s
                 .chars()
                 .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect()
+                .collect();
+            if first == "mechanics" && s[first.len()..].starts_with("::beam") {
+                return "mechanics/beam".to_string();
+            }
+            first
         };
         if let Some(group) = rest.strip_prefix('{') {
             let end = group.find('}').unwrap_or(group.len());
@@ -132,5 +147,10 @@ fn the_scan_sees_paths_groups_and_skips_other_crates() {
         crate_paths("x = my_crate::unit::f() + crate::scene::g()"),
         ["scene"]
     );
+    assert_eq!(
+        crate_paths("use crate::mechanics::beam::section::Section;"),
+        ["mechanics/beam"]
+    );
     assert!(layer_of("unit") > layer_of("integrator"));
+    assert!(layer_of("mechanics/beam") < layer_of("scene"));
 }

@@ -18,13 +18,14 @@ use crate::error::BenchError;
 use fmu_beam::integrator::{initial_state, GaState, Settings, Stats, Stepper};
 use fmu_beam::mechanics::matrix_file_beam;
 use fmu_beam::mechanics::Drive;
+use fmu_beam::mechanics::FloatingFrame;
 use fmu_beam::mechanics::SpatialSection;
 use fmu_beam::mechanics::{spatial_element_mass, spatial_element_stiffness};
 use fmu_beam::mechanics::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
 use fmu_beam::mechanics::{InertiaModel, SpatialBeam, SpatialBeamProps};
 use fmu_beam::mechanics::{Law, TimeLaw};
 use fmu_beam::scene::matrix_file::{self, MatrixFile};
-use fmu_beam::scene::{DriveKind, FrameKind};
+use fmu_beam::scene::DriveKind;
 use fmu_beam::{EngineError, Scene};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use std::f64::consts::PI;
@@ -224,7 +225,7 @@ fn props(length: f64, elements: usize, inertia: InertiaModel, alpha: f64) -> Spa
     SpatialBeamProps {
         length,
         elements,
-        frame: FrameKind::Tangent,
+        frame: FloatingFrame::Tangent,
         rho: RHO,
         e: E,
         g: G,
@@ -310,7 +311,7 @@ fn add_model(
                 Matrix3::identity(),
             );
             let b = sys.beams[g].bodies.start;
-            let beam = matrix_file_beam(file, "beam", FrameKind::Tangent, 0.0, 0.0);
+            let beam = matrix_file_beam(file, "beam", FloatingFrame::Tangent, 0.0, 0.0);
             assert_eq!(beam.nflex(), sys.bodies[b].nflex(), "same coordinates");
             sys.bodies[b] = Body3::Beam(Box::new(beam));
             (Some(g), sys.beam_frame(g, false, root))

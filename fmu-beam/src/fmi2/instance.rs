@@ -318,7 +318,6 @@ impl Instance {
         ))
     }
 
-    /// Inputs are held over a step (canInterpolateInputs = false): only an empty call is fine.
     /// fmi2SetRealInputDerivatives: the inputs are extrapolated over the next step with the
     /// derivatives of order 1 and 2 (canInterpolateInputs = true).
     pub fn set_real_input_derivatives(

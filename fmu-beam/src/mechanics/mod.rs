@@ -7,6 +7,7 @@
 
 pub(crate) mod any_system;
 pub(crate) mod beam;
+pub(crate) mod from_scene;
 pub(crate) mod multibody;
 pub(crate) mod multibody3d;
 pub(crate) mod options;
@@ -19,6 +20,7 @@ pub use beam::spatial_element::{
     mass as spatial_element_mass, stiffness as spatial_element_stiffness,
 };
 pub use beam::spatial_section::SpatialSection;
+pub use beam::FloatingFrame;
 pub use multibody::joint::Drive;
 pub use multibody::law::{Law, TimeLaw};
 pub use multibody::{Equations, System};

@@ -5,7 +5,7 @@
 use crate::mechanics::beam::planar_beam::{rot, BeamOptions, PlanarBeam, FLEX, THETA};
 use crate::mechanics::beam::planar_element::{shape, GAUSS_4};
 use crate::mechanics::beam::section::Section;
-use crate::scene::FrameKind;
+use crate::mechanics::FloatingFrame;
 use nalgebra::{DMatrix, DVector, Vector2};
 
 /// Deterministic pseudo-random numbers in [-1, 1].
@@ -23,7 +23,7 @@ impl Lcg {
     }
 }
 
-fn beam(frame: FrameKind, n: usize) -> PlanarBeam {
+fn beam(frame: FloatingFrame, n: usize) -> PlanarBeam {
     beam_with(frame, n, BeamOptions::default())
 }
 
@@ -113,7 +113,7 @@ fn random_state(b: &PlanarBeam, rng: &mut Lcg) -> (DVector<f64>, DVector<f64>, D
 #[test]
 fn mass_matrix_equals_direct_integration_of_eq_11() {
     let mut rng = Lcg(7);
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let b = beam(frame, 5);
         for _ in 0..3 {
             let (z, _, _) = random_state(&b, &mut rng);
@@ -130,7 +130,7 @@ fn mass_matrix_equals_direct_integration_of_eq_11() {
 #[test]
 fn quadratic_velocity_terms_follow_from_lagrange() {
     let mut rng = Lcg(11);
-    let b = beam(FrameKind::Tangent, 4);
+    let b = beam(FloatingFrame::Tangent, 4);
     let n = b.ndof();
     for _ in 0..3 {
         let (z, zd, _) = random_state(&b, &mut rng);
@@ -164,7 +164,7 @@ fn quadratic_velocity_terms_follow_from_lagrange() {
 #[test]
 fn gravity_is_the_gradient_of_the_potential() {
     let mut rng = Lcg(5);
-    let b = beam(FrameKind::Pinned, 3);
+    let b = beam(FloatingFrame::Pinned, 3);
     let n = b.ndof();
     let g = Vector2::new(1.3, -9.81);
     let (z, _, _) = random_state(&b, &mut rng);
@@ -186,7 +186,7 @@ fn gravity_is_the_gradient_of_the_potential() {
 }
 
 /// The beam of [`beam`] computing only the terms of `options`.
-fn beam_with(frame: FrameKind, n: usize, options: BeamOptions) -> PlanarBeam {
+fn beam_with(frame: FloatingFrame, n: usize, options: BeamOptions) -> PlanarBeam {
     PlanarBeam::with_options(
         "b",
         0.8,
@@ -211,13 +211,13 @@ fn tangents_match_finite_differences() {
     };
     // every switch of the effects, alone, and modal truncation with stiffening
     let variants = [
-        (FrameKind::Tangent, full, true),
-        (FrameKind::Pinned, full, true),
-        (FrameKind::Tangent, stiff, true),
-        (FrameKind::Pinned, stiff, true),
-        (FrameKind::Tangent, full, false),
+        (FloatingFrame::Tangent, full, true),
+        (FloatingFrame::Pinned, full, true),
+        (FloatingFrame::Tangent, stiff, true),
+        (FloatingFrame::Pinned, stiff, true),
+        (FloatingFrame::Tangent, full, false),
         (
-            FrameKind::Tangent,
+            FloatingFrame::Tangent,
             BeamOptions {
                 quadratic_velocity: false,
                 ..full
@@ -225,7 +225,7 @@ fn tangents_match_finite_differences() {
             true,
         ),
         (
-            FrameKind::Pinned,
+            FloatingFrame::Pinned,
             BeamOptions {
                 damping: false,
                 ..full
@@ -233,7 +233,7 @@ fn tangents_match_finite_differences() {
             true,
         ),
         (
-            FrameKind::Tangent,
+            FloatingFrame::Tangent,
             BeamOptions {
                 axial: false,
                 ..full
@@ -241,7 +241,7 @@ fn tangents_match_finite_differences() {
             true,
         ),
         (
-            FrameKind::Tangent,
+            FloatingFrame::Tangent,
             BeamOptions {
                 modes: Some(4),
                 ..stiff
@@ -304,7 +304,7 @@ fn tangents_match_finite_differences() {
 
 #[test]
 fn zero_force_at_rest() {
-    let b = beam(FrameKind::Tangent, 6);
+    let b = beam(FloatingFrame::Tangent, 6);
     let n = b.ndof();
     let mut z = DVector::zeros(n);
     z[0] = 0.3;
@@ -319,7 +319,7 @@ fn zero_force_at_rest() {
 /// stretching only) and the frame needs no torque.
 #[test]
 fn steady_spin_loads_axially() {
-    let b = beam(FrameKind::Tangent, 4);
+    let b = beam(FloatingFrame::Tangent, 4);
     let n = b.ndof();
     let z = DVector::zeros(n);
     let mut zd = DVector::zeros(n);
@@ -346,7 +346,7 @@ fn steady_spin_loads_axially() {
 #[test]
 fn geometric_stiffening_is_conservative_and_stiffens_under_tension() {
     let mut rng = Lcg(19);
-    let mut b = beam(FrameKind::Tangent, 4);
+    let mut b = beam(FloatingFrame::Tangent, 4);
     b.set_geometric_stiffening(true);
     let n = b.ndof();
     let (mut z, _, _) = random_state(&b, &mut rng);

@@ -174,7 +174,7 @@ fn add_beam(sys: &mut System3, spec: &BeamSpec) -> usize {
     let props = SpatialBeamProps {
         length: spec.length,
         elements,
-        frame: spec.frame,
+        frame: spec.frame.into(),
         rho: spec.material.rho,
         e: spec.material.e,
         g: spec.material.g.unwrap_or(spec.material.e / 2.6),

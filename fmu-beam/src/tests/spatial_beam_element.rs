@@ -14,8 +14,8 @@ use crate::mechanics::beam::spatial_beam::{
 use crate::mechanics::beam::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
 use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::multibody3d::build::matrix_file_beam;
+use crate::mechanics::FloatingFrame;
 use crate::scene::matrix_file::{self, MatrixFile, MatrixFileError};
-use crate::scene::FrameKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector2, Vector3};
 
 /// Deterministic pseudo-random numbers in [-1, 1].
@@ -45,7 +45,7 @@ fn c5_section() -> SpatialSection {
     SpatialSection::given(0.02 * 0.06285, 4.138e-7, 4.19e-8, 1.33242e-7)
 }
 
-fn props(length: f64, elements: usize, frame: FrameKind) -> SpatialBeamProps {
+fn props(length: f64, elements: usize, frame: FloatingFrame) -> SpatialBeamProps {
     SpatialBeamProps {
         length,
         elements,
@@ -60,7 +60,7 @@ fn props(length: f64, elements: usize, frame: FrameKind) -> SpatialBeamProps {
     }
 }
 
-fn beam(frame: FrameKind, n: usize) -> SpatialBeam {
+fn beam(frame: FloatingFrame, n: usize) -> SpatialBeam {
     SpatialBeam::new("b", &props(0.8, n, frame))
 }
 
@@ -253,7 +253,7 @@ fn element_stiffness_closed_forms() {
 /// φ = TL/(GJ_t), δ_x = PL/(EA).
 #[test]
 fn cantilever_static_tip_loads() {
-    let p = props(1.3, 5, FrameKind::Tangent);
+    let p = props(1.3, 5, FloatingFrame::Tangent);
     let b = SpatialBeam::new("b", &p);
     let s = &p.section;
     let tip = NODE_DOFS * p.elements;
@@ -328,7 +328,7 @@ const BETA_L: [f64; 5] = [
 /// ω_h² = (6c²/h²)(1 − cos κh)/(2 + cos κh), κ = (2n−1)π/(2L), checked to 1e-10.
 #[test]
 fn clamped_frequencies_converge_to_exact_in_both_planes_and_torsion() {
-    let base = props(1.0, 1, FrameKind::Tangent);
+    let base = props(1.0, 1, FloatingFrame::Tangent);
     let s = base.section;
     let mu = base.rho * s.area;
     let l = base.length;
@@ -349,7 +349,7 @@ fn clamped_frequencies_converge_to_exact_in_both_planes_and_torsion() {
     let mut err_t: Vec<Vec<f64>> = Vec::new();
     let counts = [1, 2, 4, 8, 16, 32, 64];
     for &n in &counts {
-        let b = SpatialBeam::new("b", &props(l, n, FrameKind::Tangent));
+        let b = SpatialBeam::new("b", &props(l, n, FloatingFrame::Tangent));
         let h = l / n as f64;
         let wv = field_frequencies(&b, &[V, TZ]);
         let ww = field_frequencies(&b, &[W, TY]);
@@ -424,7 +424,7 @@ fn clamped_frequencies_converge_to_exact_in_both_planes_and_torsion() {
 #[test]
 fn mass_matrix_equals_direct_integration_and_kinetic_energy() {
     let mut rng = Lcg(7);
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let p = props(0.8, 4, frame);
         let b = SpatialBeam::new("b", &p);
         for _ in 0..3 {
@@ -484,7 +484,7 @@ fn quadratic_velocity_vector_follows_from_lagrange() {
         let w = jr(&psi) * pd;
         assert!((at(0.0).transpose() * ad - skew(&w)).amax() < 1e-8);
     }
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let b = beam(frame, 3);
         let (n, nf) = (b.ndof(), b.nflex());
         for _ in 0..3 {
@@ -542,7 +542,7 @@ fn quadratic_velocity_vector_follows_from_lagrange() {
 #[test]
 fn gravity_is_the_gradient_of_the_potential() {
     let mut rng = Lcg(5);
-    let b = beam(FrameKind::Pinned, 3);
+    let b = beam(FloatingFrame::Pinned, 3);
     let g = Vector3::new(1.3, -9.81, 2.0);
     let s = random_state(&b, &mut rng);
     let r0 = rng.vec3(1.0);
@@ -578,7 +578,7 @@ fn residual_equals_mass_times_acceleration_plus_forces() {
             rayleigh_alpha: 3.0,
             rayleigh_beta: 1e-4,
             inertia: model,
-            ..props(0.8, 3, FrameKind::Tangent)
+            ..props(0.8, 3, FloatingFrame::Tangent)
         };
         let b = SpatialBeam::new("b", &p);
         let nf = b.nflex();
@@ -601,7 +601,7 @@ fn residual_equals_mass_times_acceleration_plus_forces() {
 
 #[test]
 fn zero_force_at_rest_and_steady_spin() {
-    let b = beam(FrameKind::Tangent, 4);
+    let b = beam(FloatingFrame::Tangent, 4);
     let (n, nf) = (b.ndof(), b.nflex());
     let a = Rotation3::from_scaled_axis(Vector3::new(0.3, -0.2, 0.9)).into_inner();
     let zero = DVector::zeros(n);
@@ -639,7 +639,7 @@ fn zero_force_at_rest_and_steady_spin() {
 #[test]
 fn planar_reduction_equals_the_planar_beam() {
     let mut rng = Lcg(23);
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let n_el = 4;
         let p = SpatialBeamProps {
             section: SpatialSection::rectangle(0.02, 0.01),
@@ -718,7 +718,7 @@ fn planar_reduction_equals_the_planar_beam() {
 /// Substructures: k parts of length L/k hold the whole mass; each part is the same beam.
 #[test]
 fn substructures_split_the_beam() {
-    let p = props(1.0, 2, FrameKind::Tangent);
+    let p = props(1.0, 2, FloatingFrame::Tangent);
     let whole = SpatialBeam::new(
         "w",
         &SpatialBeamProps {
@@ -743,7 +743,7 @@ fn substructures_split_the_beam() {
 #[test]
 fn frozen_inertia_is_the_undeformed_full_model() {
     let mut rng = Lcg(31);
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let full = beam(frame, 3);
         let mut frozen = full.clone();
         assert_eq!(
@@ -812,7 +812,7 @@ fn matrix_file_of_the_element_reproduces_the_element() {
     let mut rng = Lcg(41);
     let dir = std::env::temp_dir().join(format!("spatial_beam_element_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for frame in [FrameKind::Tangent, FrameKind::Pinned] {
+    for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
         let p = SpatialBeamProps {
             inertia: InertiaModel::Frozen,
             ..props(0.6, 1, frame)
@@ -859,7 +859,7 @@ fn refusal(text: &str) -> MatrixFileError {
 /// Every refusal names the file, the line (where there is one) and the rule.
 #[test]
 fn matrix_file_refusals_name_file_line_and_rule() {
-    let good = element_file_text(&props(0.5, 1, FrameKind::Tangent));
+    let good = element_file_text(&props(0.5, 1, FloatingFrame::Tangent));
     assert!(matrix_file::parse(&good, "good.txt").is_ok());
     let lines: Vec<&str> = good.lines().collect();
     let line_of = |prefix: &str| lines.iter().position(|l| l.starts_with(prefix)).unwrap();
@@ -1028,7 +1028,7 @@ fn c1_fe_frequencies_in_both_planes() {
     let p = SpatialBeamProps {
         length: 2.0,
         elements: 10,
-        frame: FrameKind::Tangent,
+        frame: FloatingFrame::Tangent,
         rho: 2700.0,
         e: 72e9,
         g: 27e9,
@@ -1068,7 +1068,7 @@ fn frozen_inertia_cost_and_error_against_full() {
     let p = SpatialBeamProps {
         rayleigh_alpha: 0.0,
         rayleigh_beta: 0.0,
-        ..props(0.2, 1, FrameKind::Tangent)
+        ..props(0.2, 1, FloatingFrame::Tangent)
     };
     let full = SpatialBeam::new("full", &p);
     let mut frozen = full.clone();

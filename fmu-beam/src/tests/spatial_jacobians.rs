@@ -9,7 +9,8 @@ use crate::mechanics::multibody::joint::Drive;
 use crate::mechanics::multibody::law::{Law, TimeLaw};
 use crate::mechanics::multibody::Equations;
 use crate::mechanics::multibody3d::{JointKind3, Load3, RigidBody3, System3};
-use crate::scene::{DriveKind, FrameKind};
+use crate::mechanics::FloatingFrame;
+use crate::scene::DriveKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
 /// A small deterministic generator (xorshift) of numbers in [−1, 1].
@@ -59,14 +60,14 @@ fn system(rng: &mut Random) -> System3 {
     let mut sys = System3::new(Some(Vector3::new(0.0, 0.0, -9.81)));
     let b0 = sys.add_beam(
         "b0",
-        &props(FrameKind::Tangent),
+        &props(FloatingFrame::Tangent),
         2,
         rng.vector(0.5),
         rng.rotation(),
     );
     let b1 = sys.add_beam(
         "b1",
-        &props(FrameKind::Pinned),
+        &props(FloatingFrame::Pinned),
         1,
         rng.vector(0.5),
         rng.rotation(),

@@ -9,7 +9,7 @@ use crate::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
 use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::multibody3d::quaternion::{g_body, rotation};
 use crate::mechanics::multibody3d::{JointKind3, RigidBody3, System3};
-use crate::scene::FrameKind;
+use crate::mechanics::FloatingFrame;
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 fn fixed(h: f64) -> Settings {
@@ -128,7 +128,7 @@ fn c2_props(elements: usize) -> SpatialBeamProps {
     SpatialBeamProps {
         length: 0.4,
         elements,
-        frame: FrameKind::Tangent,
+        frame: FloatingFrame::Tangent,
         rho: 5540.0,
         e: 1e9,
         g: 1e9 / 2.6,
@@ -144,7 +144,7 @@ fn c2_3d(h: f64) -> Vec<(f64, f64)> {
     let mut sys = System3::new(Some(Vector3::new(0.0, -9.81, 0.0)));
     // in the shipped scene's frame, through both ends
     let props = SpatialBeamProps {
-        frame: FrameKind::Pinned,
+        frame: FloatingFrame::Pinned,
         ..c2_props(10)
     };
     let g = sys.add_beam("beam", &props, 1, Vector3::zeros(), Matrix3::identity());
@@ -231,7 +231,7 @@ fn c5_beam(length: f64, elements: usize, alpha: f64) -> SpatialBeamProps {
     SpatialBeamProps {
         length,
         elements,
-        frame: FrameKind::Tangent,
+        frame: FloatingFrame::Tangent,
         rho: 7800.0,
         e: 210e9,
         g: 8.077e10,

@@ -12,11 +12,14 @@
 
 use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
-use crate::scene::{BeamSpec, FrameKind};
+use super::FloatingFrame;
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix2, Vector2};
 use std::cell::Cell;
 
-/// Which terms a beam computes (the resolved effects of its scene, `unit::effects`). A term
+mod build;
+mod stiffening;
+
+/// Which terms a beam computes (the resolved effects of its scene). A term
 /// that is off is not evaluated at all; the full model has every term on and no truncation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BeamOptions {
@@ -127,7 +130,7 @@ pub struct PlanarBeam {
     pub name: String,
     pub length: f64,
     pub elements: usize,
-    pub frame: FrameKind,
+    pub frame: FloatingFrame,
     pub section: Section,
     /// Mass per unit length ρA (kg/m), EA (N), EJ (N m^2).
     pub mu: f64,
@@ -174,220 +177,7 @@ pub struct PlanarBeam {
     strain: StrainRows,
 }
 
-/// The constant parts of an element's nonlinear strain (all elements of a beam are alike).
-#[derive(Debug, Clone, Default)]
-struct StrainRows {
-    /// dv/dx as a row on the element's coordinates, at each point of `GAUSS_4`.
-    slopes: [[f64; ELEMENT_DOFS]; 4],
-    /// Σ w ds dsᵀ over the points: the Hessian of the element mean of v'²/2.
-    hv: [[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
-}
-
-impl StrainRows {
-    fn new(l: f64) -> StrainRows {
-        let mut r = StrainRows::default();
-        for (g, &(xi, w)) in GAUSS_4.iter().enumerate() {
-            let ds = planar_element::slope(xi, l);
-            for p in 0..ELEMENT_DOFS {
-                r.slopes[g][p] = ds[p];
-                for q in 0..ELEMENT_DOFS {
-                    r.hv[p][q] += w * ds[p] * ds[q];
-                }
-            }
-        }
-        r
-    }
-}
-
-/// Full-beam integrals before the boundary conditions remove coordinates.
-struct FullIntegrals {
-    sbar: DMatrix<f64>,
-    a: DVector<f64>,
-    b: DVector<f64>,
-    mff: DMatrix<f64>,
-    w: DMatrix<f64>,
-    kff: DMatrix<f64>,
-}
-
 impl PlanarBeam {
-    /// Builds the beam from its (validated) scene entry.
-    /// (Every term on, geometric stiffening as the scene entry says, no truncation.)
-    pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
-        let options = BeamOptions {
-            geometric_stiffening: spec.geometric_stiffening,
-            modes: spec.modes,
-            ..BeamOptions::default()
-        };
-        PlanarBeam::part_of(spec, &spec.name, spec.length, options)
-    }
-
-    /// One floating frame of a (validated) scene beam: the whole beam, or one of its
-    /// substructures, named `name`, of length `length`, computing the terms of `options`.
-    pub fn part_of(spec: &BeamSpec, name: &str, length: f64, options: BeamOptions) -> PlanarBeam {
-        PlanarBeam::with_options(
-            name,
-            length,
-            crate::scene::Scene::beam_layout(spec).0,
-            spec.frame,
-            spec.material.rho,
-            spec.material.e,
-            Section::from_spec(&spec.section),
-            spec.rayleigh.alpha,
-            spec.rayleigh.beta,
-            options,
-        )
-    }
-
-    /// The full model (every term on, no truncation).
-    pub fn new(
-        name: &str,
-        length: f64,
-        elements: usize,
-        frame: FrameKind,
-        rho: f64,
-        e: f64,
-        section: Section,
-        rayleigh_alpha: f64,
-        rayleigh_beta: f64,
-    ) -> PlanarBeam {
-        PlanarBeam::with_options(
-            name,
-            length,
-            elements,
-            frame,
-            rho,
-            e,
-            section,
-            rayleigh_alpha,
-            rayleigh_beta,
-            BeamOptions::default(),
-        )
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_options(
-        name: &str,
-        length: f64,
-        elements: usize,
-        frame: FrameKind,
-        rho: f64,
-        e: f64,
-        section: Section,
-        rayleigh_alpha: f64,
-        rayleigh_beta: f64,
-        options: BeamOptions,
-    ) -> PlanarBeam {
-        let n_full = 3 * (elements + 1);
-        let kept: Vec<usize> = (0..n_full)
-            .filter(|&i| match frame {
-                FrameKind::Tangent => i >= 3,
-                FrameKind::Pinned => i >= 2 && i != 3 * elements + 1,
-            })
-            .filter(|&i| options.axial || i % 3 != 0)
-            .collect();
-        let mu = rho * section.area;
-        let ea = e * section.area;
-        let ej = e * section.second_moment;
-        let full = full_integrals(length, elements, mu, ea, ej);
-        let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
-        let pick = |m: &DMatrix<f64>| m.select_rows(kept.iter()).select_columns(kept.iter());
-        let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
-        let mff = pick(&full.mff);
-        let kff = pick(&full.kff);
-        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
-        let mass = mu * length;
-        let node_map = |node: usize, x: f64| {
-            let mut sp_full = DMatrix::zeros(2, n_full);
-            sp_full[(0, 3 * node)] = 1.0;
-            sp_full[(1, 3 * node + 1)] = 1.0;
-            let mut sphi_full = DVector::zeros(n_full);
-            sphi_full[3 * node + 2] = 1.0;
-            PointMap {
-                s0: Vector2::new(x, 0.0),
-                sp: pick_cols(&sp_full),
-                sphi: pick_v(&sphi_full),
-            }
-        };
-        let beam = PlanarBeam {
-            name: name.to_string(),
-            length,
-            elements,
-            frame,
-            section,
-            mu,
-            ea,
-            ej,
-            rayleigh_alpha,
-            rayleigh_beta,
-            mass,
-            st0: Vector2::new(mass * length / 2.0, 0.0),
-            i0: mass * length * length / 3.0,
-            sbar: pick_cols(&full.sbar),
-            a: pick_v(&full.a),
-            b: pick_v(&full.b),
-            w: pick(&full.w),
-            mff,
-            kff,
-            dff,
-            flange_a: node_map(0, 0.0),
-            flange_b: node_map(elements, length),
-            kept,
-            geometric_stiffening: options.geometric_stiffening,
-            options,
-            basis: None,
-            counts: TermCounts::default(),
-            band: Vec::new(),
-            strain: StrainRows::new(length / elements as f64),
-        };
-        match options.modes {
-            Some(k) => {
-                let k = k.min(beam.kept.len());
-                beam.truncated(k).banded()
-            }
-            None => beam.banded(),
-        }
-    }
-
-    /// The beam with its [`PlanarBeam::band`] found from its matrices.
-    fn banded(mut self) -> PlanarBeam {
-        let nf = self.mff.nrows();
-        self.band = (0..nf)
-            .map(|k| {
-                let nonzero = |l: usize| {
-                    self.mff[(k, l)] != 0.0
-                        || self.mff[(l, k)] != 0.0
-                        || self.w[(k, l)] != 0.0
-                        || self.w[(l, k)] != 0.0
-                        || self.kff[(k, l)] != 0.0
-                        || self.dff[(k, l)] != 0.0
-                };
-                let lo = (0..nf).find(|&l| nonzero(l)).unwrap_or(k);
-                let hi = (0..nf).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
-                lo..hi.max(lo)
-            })
-            .collect();
-        self
-    }
-
-    /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
-    /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
-    fn truncated(mut self, k: usize) -> PlanarBeam {
-        let phi = lowest_modes(&self.kff, &self.mff, k);
-        let pt = phi.transpose();
-        self.sbar = &self.sbar * &phi;
-        self.a = &pt * &self.a;
-        self.b = &pt * &self.b;
-        self.w = &pt * &self.w * &phi;
-        self.mff = &pt * &self.mff * &phi;
-        self.kff = &pt * &self.kff * &phi;
-        self.dff = &self.mff * self.rayleigh_alpha + &self.kff * self.rayleigh_beta;
-        for map in [&mut self.flange_a, &mut self.flange_b] {
-            reduce_map(map, &phi);
-        }
-        self.basis = Some(phi);
-        self
-    }
-
     /// Nodal deformation (kept coordinates) of the body coordinates z.
     fn nodal(&self, z: &DVectorView<f64>) -> DVector<f64> {
         let f = z.rows(FLEX, self.nflex());
@@ -753,106 +543,6 @@ impl PlanarBeam {
         map
     }
 
-    pub fn set_geometric_stiffening(&mut self, on: bool) {
-        self.geometric_stiffening = on;
-    }
-
-    /// Visits each element with its axial strain ε = u' + ½⟨v'²⟩, the element mean of v'²
-    /// making ε (and the axial force) constant per element, which avoids membrane locking:
-    /// (kept index of each element coordinate, ℓ, ε, ∂ε/∂q_e, ⟨v'_q v'_qᵀ⟩).
-    #[allow(clippy::type_complexity)]
-    fn for_element_strains(
-        &self,
-        fq: &DVector<f64>,
-        mut visit: impl FnMut(
-            &[Option<usize>; ELEMENT_DOFS],
-            f64,
-            f64,
-            &[f64; ELEMENT_DOFS],
-            &[[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
-        ),
-    ) {
-        let l = self.length / self.elements as f64;
-        let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
-        let (slopes, hv) = (&self.strain.slopes, &self.strain.hv);
-        for j in 0..self.elements {
-            let idx: [Option<usize>; ELEMENT_DOFS] =
-                std::array::from_fn(|p| self.flex_index(3 * j + p));
-            let qe: [f64; ELEMENT_DOFS] = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fq[k]));
-            let mut eps: f64 = (0..ELEMENT_DOFS).map(|p| da[p] * qe[p]).sum();
-            let mut de = da;
-            for (ds, &(_, w)) in slopes.iter().zip(&GAUSS_4) {
-                let dv: f64 = (0..ELEMENT_DOFS).map(|p| ds[p] * qe[p]).sum();
-                eps += 0.5 * w * dv * dv;
-                for p in 0..ELEMENT_DOFS {
-                    de[p] += w * dv * ds[p];
-                }
-            }
-            visit(&idx, l, eps, &de, hv);
-        }
-    }
-
-    /// Internal force of the nonlinear strain beyond the linear K_ff q_f:
-    /// EA ℓ (ε ∂ε/∂q - u' ∂u'/∂q) per element, added into `out` (projected on the modes under
-    /// truncation).
-    fn stiffening_force(&self, z: &DVectorView<f64>, out: &mut [f64]) {
-        let ea = self.ea;
-        let fq = self.nodal(z);
-        let mut nodal = DVector::zeros(self.kept.len());
-        self.for_element_strains(&fq, |idx, l, eps, de, _| {
-            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
-            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
-            for p in 0..ELEMENT_DOFS {
-                if let Some(k) = idx[p] {
-                    nodal[k] += ea * l * (eps * de[p] - du * da[p]);
-                }
-            }
-        });
-        let projected = match &self.basis {
-            Some(phi) => phi.tr_mul(&nodal),
-            None => nodal,
-        };
-        for (o, x) in out.iter_mut().zip(projected.iter()) {
-            *o += x;
-        }
-    }
-
-    /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
-    fn stiffening_tangent(&self, z: &DVectorView<f64>, kt: &mut DMatrixViewMut<f64>) {
-        let ea = self.ea;
-        let fq = self.nodal(z);
-        let nk = self.kept.len();
-        let mut nodal = DMatrix::zeros(nk, nk);
-        self.for_element_strains(&fq, |idx, l, eps, de, hv| {
-            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
-            for p in 0..ELEMENT_DOFS {
-                let Some(kp) = idx[p] else { continue };
-                for r in 0..ELEMENT_DOFS {
-                    let Some(kr) = idx[r] else { continue };
-                    nodal[(kp, kr)] += ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
-                }
-            }
-        });
-        let nf = self.nflex();
-        let mut block = kt.view_mut((FLEX, FLEX), (nf, nf));
-        match &self.basis {
-            Some(phi) => block += phi.tr_mul(&nodal) * phi,
-            None => block += nodal,
-        }
-    }
-
-    /// Strain energy of the nonlinear strain beyond ½ q_fᵀ K_ff q_f.
-    fn stiffening_energy(&self, z: &DVectorView<f64>) -> f64 {
-        let mut e = 0.0;
-        let ea = self.ea;
-        let fq = self.nodal(z);
-        self.for_element_strains(&fq, |idx, l, eps, _, _| {
-            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
-            e += 0.5 * ea * l * (eps * eps - du * du);
-        });
-        e
-    }
-
     /// Static deformation under a transverse tip force, scaled to a tip displacement `tip`
     /// (tangent frame): the initial shape of case C1.
     /// Under modal truncation the shape is the static solution within the kept modes.
@@ -868,71 +558,33 @@ impl PlanarBeam {
     }
 }
 
-/// Integrals of eq. (11) over all N elements, before boundary conditions (eq. (8)–(12)).
-fn full_integrals(length: f64, elements: usize, mu: f64, ea: f64, ej: f64) -> FullIntegrals {
-    let n_full = 3 * (elements + 1);
-    let l = length / elements as f64;
-    let mut out = FullIntegrals {
-        sbar: DMatrix::zeros(2, n_full),
-        a: DVector::zeros(n_full),
-        b: DVector::zeros(n_full),
-        mff: DMatrix::zeros(n_full, n_full),
-        w: DMatrix::zeros(n_full, n_full),
-        kff: DMatrix::zeros(n_full, n_full),
-    };
-    let ke = planar_element::stiffness(ea, ej, l);
-    for j in 0..elements {
-        let o = 3 * j; // the connectivity matrix B_j of eq. (9)
-        for &(xi, wgt) in &GAUSS_4 {
-            let (s1, s2) = planar_element::shape(xi, l);
-            let dm = mu * l * wgt;
-            let x0 = (j as f64 + xi) * l;
+/// The constant parts of an element's nonlinear strain (all elements of a beam are alike).
+#[derive(Debug, Clone, Default)]
+struct StrainRows {
+    /// dv/dx as a row on the element's coordinates, at each point of `GAUSS_4`.
+    slopes: [[f64; ELEMENT_DOFS]; 4],
+    /// Σ w ds dsᵀ over the points: the Hessian of the element mean of v'²/2.
+    hv: [[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
+}
+
+impl StrainRows {
+    fn new(l: f64) -> StrainRows {
+        let mut r = StrainRows::default();
+        for (g, &(xi, w)) in GAUSS_4.iter().enumerate() {
+            let ds = planar_element::slope(xi, l);
             for p in 0..ELEMENT_DOFS {
-                out.sbar[(0, o + p)] += dm * s1[p];
-                out.sbar[(1, o + p)] += dm * s2[p];
-                out.a[o + p] += dm * s1[p] * x0;
-                out.b[o + p] += dm * s2[p] * x0;
+                r.slopes[g][p] = ds[p];
                 for q in 0..ELEMENT_DOFS {
-                    out.mff[(o + p, o + q)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
-                    out.w[(o + p, o + q)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
+                    r.hv[p][q] += w * ds[p] * ds[q];
                 }
             }
         }
-        for p in 0..ELEMENT_DOFS {
-            for q in 0..ELEMENT_DOFS {
-                out.kff[(o + p, o + q)] += ke[p][q];
-            }
-        }
+        r
     }
-    out
 }
 
 /// Expresses a point map in modal coordinates: S_p Φ and Φᵀ S_φ.
 fn reduce_map(map: &mut PointMap, phi: &DMatrix<f64>) {
     map.sp = &map.sp * phi;
     map.sphi = phi.tr_mul(&map.sphi);
-}
-
-/// The lowest `k` modes of K φ = ω² M φ (columns, ascending ω, Φᵀ M Φ = I), through the
-/// Cholesky factor of the (positive definite) mass matrix.
-pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix<f64> {
-    let l = mff
-        .clone()
-        .cholesky()
-        .expect("the consistent mass matrix is positive definite")
-        .l();
-    let linv = l
-        .clone()
-        .try_inverse()
-        .expect("a Cholesky factor is invertible");
-    let a = &linv * kff * linv.transpose();
-    let a = (&a + a.transpose()) * 0.5;
-    let eig = a.symmetric_eigen();
-    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    let cols: Vec<_> = order[..k]
-        .iter()
-        .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
-        .collect();
-    DMatrix::from_columns(&cols)
 }

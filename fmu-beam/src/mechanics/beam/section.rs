@@ -1,7 +1,6 @@
 //! Cross-section properties: area and second moment of area for in-plane bending.
 //! Kept apart from the element that uses them.
 
-use crate::scene::SectionSpec;
 use std::f64::consts::PI;
 
 /// Section constants of a planar beam.
@@ -14,21 +13,6 @@ pub struct Section {
 }
 
 impl Section {
-    /// Resolves a validated section spec; `a` is the in-plane height, `b` the width.
-    pub fn from_spec(s: &SectionSpec) -> Section {
-        let g = |v: Option<f64>| v.unwrap_or(0.0);
-        match s.shape.as_deref() {
-            Some("rectangle") => Section::rectangle(g(s.a), g(s.b)),
-            Some("hollow_rectangle") => Section::hollow_rectangle(g(s.a), g(s.b), g(s.t)),
-            Some("circle") => Section::circle(g(s.d)),
-            Some("hollow_circle") => Section::hollow_circle(g(s.d), g(s.t)),
-            _ => Section {
-                area: g(s.area),
-                second_moment: g(s.second_moment),
-            },
-        }
-    }
-
     pub fn rectangle(a: f64, b: f64) -> Section {
         Section {
             area: a * b,

@@ -17,12 +17,13 @@ use crate::mechanics::beam::spatial_beam::{
     InertiaModel, SpatialBeam, SpatialBeamProps, SpatialPointMap,
 };
 use crate::mechanics::beam::spatial_section::SpatialSection;
+use crate::mechanics::beam::FloatingFrame;
 use crate::mechanics::multibody::joint::Drive;
 use crate::mechanics::multibody::law::TimeLaw;
 use crate::mechanics::multibody::system::input_slots;
 use crate::mechanics::Effects;
 use crate::scene::matrix_file::{self, MatrixFile};
-use crate::scene::{BeamSpec, FrameKind, InertiaSpec, JointKind, LawSpec, Scene, SectionSpec};
+use crate::scene::{BeamSpec, InertiaSpec, JointKind, LawSpec, Scene, SectionSpec};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Where the scene's parts are in the built system.
@@ -95,7 +96,7 @@ fn props(b: &BeamSpec, elements: usize, damping: bool) -> SpatialBeamProps {
     SpatialBeamProps {
         length: b.length,
         elements,
-        frame: b.frame,
+        frame: b.frame.into(),
         rho: b.material.rho,
         e: b.material.e,
         g: b.material.g.unwrap_or(b.material.e),
@@ -146,7 +147,11 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
             } else {
                 (0.0, 0.0)
             };
-            sys.add_beam_body(matrix_file_beam(&m, &b.name, b.frame, alpha, beta), at, rot)
+            sys.add_beam_body(
+                matrix_file_beam(&m, &b.name, b.frame.into(), alpha, beta),
+                at,
+                rot,
+            )
         } else {
             let (elements, frames) = Scene::beam_layout(b);
             sys.add_beam(
@@ -303,7 +308,7 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
 pub fn matrix_file_beam(
     m: &MatrixFile,
     name: &str,
-    frame: FrameKind,
+    frame: FloatingFrame,
     alpha: f64,
     beta: f64,
 ) -> SpatialBeam {

@@ -1,0 +1,236 @@
+//! A planar beam's construction: the full-beam integrals of the shape functions (4-point
+//! Gauss, exact for every integrand of the planar paper's eq. (11)), the frame's boundary
+//! conditions and the options applied (no axial coordinates, band structure, modal truncation).
+
+use super::*;
+
+impl PlanarBeam {
+    /// The full model (every term on, no truncation).
+    pub fn new(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FloatingFrame,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+    ) -> PlanarBeam {
+        PlanarBeam::with_options(
+            name,
+            length,
+            elements,
+            frame,
+            rho,
+            e,
+            section,
+            rayleigh_alpha,
+            rayleigh_beta,
+            BeamOptions::default(),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_options(
+        name: &str,
+        length: f64,
+        elements: usize,
+        frame: FloatingFrame,
+        rho: f64,
+        e: f64,
+        section: Section,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+        options: BeamOptions,
+    ) -> PlanarBeam {
+        let n_full = 3 * (elements + 1);
+        let kept: Vec<usize> = (0..n_full)
+            .filter(|&i| match frame {
+                FloatingFrame::Tangent => i >= 3,
+                FloatingFrame::Pinned => i >= 2 && i != 3 * elements + 1,
+            })
+            .filter(|&i| options.axial || i % 3 != 0)
+            .collect();
+        let mu = rho * section.area;
+        let ea = e * section.area;
+        let ej = e * section.second_moment;
+        let full = full_integrals(length, elements, mu, ea, ej);
+        let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
+        let pick = |m: &DMatrix<f64>| m.select_rows(kept.iter()).select_columns(kept.iter());
+        let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
+        let mff = pick(&full.mff);
+        let kff = pick(&full.kff);
+        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
+        let mass = mu * length;
+        let node_map = |node: usize, x: f64| {
+            let mut sp_full = DMatrix::zeros(2, n_full);
+            sp_full[(0, 3 * node)] = 1.0;
+            sp_full[(1, 3 * node + 1)] = 1.0;
+            let mut sphi_full = DVector::zeros(n_full);
+            sphi_full[3 * node + 2] = 1.0;
+            PointMap {
+                s0: Vector2::new(x, 0.0),
+                sp: pick_cols(&sp_full),
+                sphi: pick_v(&sphi_full),
+            }
+        };
+        let beam = PlanarBeam {
+            name: name.to_string(),
+            length,
+            elements,
+            frame,
+            section,
+            mu,
+            ea,
+            ej,
+            rayleigh_alpha,
+            rayleigh_beta,
+            mass,
+            st0: Vector2::new(mass * length / 2.0, 0.0),
+            i0: mass * length * length / 3.0,
+            sbar: pick_cols(&full.sbar),
+            a: pick_v(&full.a),
+            b: pick_v(&full.b),
+            w: pick(&full.w),
+            mff,
+            kff,
+            dff,
+            flange_a: node_map(0, 0.0),
+            flange_b: node_map(elements, length),
+            kept,
+            geometric_stiffening: options.geometric_stiffening,
+            options,
+            basis: None,
+            counts: TermCounts::default(),
+            band: Vec::new(),
+            strain: StrainRows::new(length / elements as f64),
+        };
+        match options.modes {
+            Some(k) => {
+                let k = k.min(beam.kept.len());
+                beam.truncated(k).banded()
+            }
+            None => beam.banded(),
+        }
+    }
+
+    /// The beam with its [`PlanarBeam::band`] found from its matrices.
+    pub(super) fn banded(mut self) -> PlanarBeam {
+        let nf = self.mff.nrows();
+        self.band = (0..nf)
+            .map(|k| {
+                let nonzero = |l: usize| {
+                    self.mff[(k, l)] != 0.0
+                        || self.mff[(l, k)] != 0.0
+                        || self.w[(k, l)] != 0.0
+                        || self.w[(l, k)] != 0.0
+                        || self.kff[(k, l)] != 0.0
+                        || self.dff[(k, l)] != 0.0
+                };
+                let lo = (0..nf).find(|&l| nonzero(l)).unwrap_or(k);
+                let hi = (0..nf).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
+                lo..hi.max(lo)
+            })
+            .collect();
+        self
+    }
+
+    /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
+    /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
+    pub(super) fn truncated(mut self, k: usize) -> PlanarBeam {
+        let phi = lowest_modes(&self.kff, &self.mff, k);
+        let pt = phi.transpose();
+        self.sbar = &self.sbar * &phi;
+        self.a = &pt * &self.a;
+        self.b = &pt * &self.b;
+        self.w = &pt * &self.w * &phi;
+        self.mff = &pt * &self.mff * &phi;
+        self.kff = &pt * &self.kff * &phi;
+        self.dff = &self.mff * self.rayleigh_alpha + &self.kff * self.rayleigh_beta;
+        for map in [&mut self.flange_a, &mut self.flange_b] {
+            reduce_map(map, &phi);
+        }
+        self.basis = Some(phi);
+        self
+    }
+}
+
+/// Full-beam integrals before the boundary conditions remove coordinates.
+pub(super) struct FullIntegrals {
+    sbar: DMatrix<f64>,
+    a: DVector<f64>,
+    b: DVector<f64>,
+    mff: DMatrix<f64>,
+    w: DMatrix<f64>,
+    kff: DMatrix<f64>,
+}
+
+/// Integrals of eq. (11) over all N elements, before boundary conditions (eq. (8)–(12)).
+pub(super) fn full_integrals(
+    length: f64,
+    elements: usize,
+    mu: f64,
+    ea: f64,
+    ej: f64,
+) -> FullIntegrals {
+    let n_full = 3 * (elements + 1);
+    let l = length / elements as f64;
+    let mut out = FullIntegrals {
+        sbar: DMatrix::zeros(2, n_full),
+        a: DVector::zeros(n_full),
+        b: DVector::zeros(n_full),
+        mff: DMatrix::zeros(n_full, n_full),
+        w: DMatrix::zeros(n_full, n_full),
+        kff: DMatrix::zeros(n_full, n_full),
+    };
+    let ke = planar_element::stiffness(ea, ej, l);
+    for j in 0..elements {
+        let o = 3 * j; // the connectivity matrix B_j of eq. (9)
+        for &(xi, wgt) in &GAUSS_4 {
+            let (s1, s2) = planar_element::shape(xi, l);
+            let dm = mu * l * wgt;
+            let x0 = (j as f64 + xi) * l;
+            for p in 0..ELEMENT_DOFS {
+                out.sbar[(0, o + p)] += dm * s1[p];
+                out.sbar[(1, o + p)] += dm * s2[p];
+                out.a[o + p] += dm * s1[p] * x0;
+                out.b[o + p] += dm * s2[p] * x0;
+                for q in 0..ELEMENT_DOFS {
+                    out.mff[(o + p, o + q)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
+                    out.w[(o + p, o + q)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
+                }
+            }
+        }
+        for p in 0..ELEMENT_DOFS {
+            for q in 0..ELEMENT_DOFS {
+                out.kff[(o + p, o + q)] += ke[p][q];
+            }
+        }
+    }
+    out
+}
+
+/// The lowest `k` modes of K φ = ω² M φ (columns, ascending ω, Φᵀ M Φ = I), through the
+/// Cholesky factor of the (positive definite) mass matrix.
+pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix<f64> {
+    let l = mff
+        .clone()
+        .cholesky()
+        .expect("the consistent mass matrix is positive definite")
+        .l();
+    let linv = l
+        .clone()
+        .try_inverse()
+        .expect("a Cholesky factor is invertible");
+    let a = &linv * kff * linv.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = a.symmetric_eigen();
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let cols: Vec<_> = order[..k]
+        .iter()
+        .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
+        .collect();
+    DMatrix::from_columns(&cols)
+}
