@@ -154,3 +154,34 @@ fn the_scan_sees_paths_groups_and_skips_other_crates() {
     assert!(layer_of("unit") > layer_of("integrator"));
     assert!(layer_of("mechanics/beam") < layer_of("scene"));
 }
+
+/// Files a person can hold (issue 33): a source file of the workspace longer than
+/// [`LONG_FILE`] lines says why in its first doc comment (a line with "Over 600 lines").
+const LONG_FILE: usize = 650;
+
+#[test]
+fn every_long_file_says_why_in_its_first_comment() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = Vec::new();
+    for krate in ["fmu-beam/src", "fmu-harness/src", "bench/src"] {
+        rust_files(&root.join(krate), &mut files);
+    }
+    assert!(files.len() > 100, "only {} files found", files.len());
+    let silent: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let text = std::fs::read_to_string(f).expect("readable");
+            let lines = text.lines().count();
+            let says = text
+                .lines()
+                .take_while(|l| l.starts_with("//!") || l.trim().is_empty())
+                .any(|l| l.contains("Over 600 lines"));
+            (lines > LONG_FILE && !says).then(|| format!("{} ({lines} lines)", f.display()))
+        })
+        .collect();
+    assert!(
+        silent.is_empty(),
+        "long files that do not say why:\n{}",
+        silent.join("\n")
+    );
+}

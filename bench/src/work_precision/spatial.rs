@@ -8,6 +8,9 @@
 //! quadratic-velocity terms the variants drop are large enough to see; and what the planar
 //! reduction saves: a 3D scene with planar motion (scenes/rollup_3d_z.toml) with the planar
 //! element that `formulation = "auto"` picks, against the 3D element.
+//!
+//! Over 600 lines: the 3D section of the study (its cases built in code, their runs, their report)
+//! kept together; a benchmark, not the product.
 
 use super::report;
 use super::{

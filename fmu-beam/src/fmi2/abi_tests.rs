@@ -9,6 +9,8 @@
 //! independent instances (interleaved, on threads) reproduce a run bit for bit; fmi2Instantiate
 //! refuses a wrong GUID, missing resources, a bad scene, with a message; file URI forms;
 //! every '%' of a message is doubled.
+//!
+//! Over 600 lines on purpose: one test per rule of the C ABI, read as one list.
 
 // Calling the C ABI takes unsafe code: these tests live in `fmi2/`, where the crate allows it.
 

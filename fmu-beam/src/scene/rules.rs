@@ -4,6 +4,9 @@
 //! has a JSON-Schema form ([`Schema`]), into the scene schema. A test refuses one scene per rule
 //! (`tests/refused_scenes.toml`) and checks the rule's code and field; so the page lists what the
 //! validator does, no more and no less.
+//!
+//! Over 600 lines on purpose: one entry per rule, the table the generated reference lists, kept as
+//! one table.
 
 /// Which scenes a rule applies to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,6 +5,9 @@
 //! against Lagrange's equations, gravity against its potential, the planar reduction (in-plane
 //! states give the planar beam's terms to 1e-12), the frozen-inertia variant and the beam from
 //! a matrix file (parser refusals, the element's own matrices reproducing the element).
+//!
+//! Over 600 lines on purpose: the spatial element's checks, one test per property, read as one
+//! list.
 
 use crate::mechanics::beam::planar_beam::{PlanarBeam, FLEX as PFLEX};
 use crate::mechanics::beam::planar_element::GAUSS_4;

@@ -2,8 +2,8 @@
 //! position correction, scaling of the iteration matrix, and local error control.
 //!
 //! Here: the state, the coefficients, the [`Stepper`] and its step loop ([`Stepper::advance`]:
-//! landing on communication points and law jumps, splits, retries; one method of about 200
-//! lines, the loop read as one). One step's Newton iterations are in `newton_step`, the error
+//! landing on communication points and law jumps, splits, retries). Over 600 lines because
+//! `advance` is one method of about 200 lines: the loop reads as one. One step's Newton iterations are in `newton_step`, the error
 //! estimate and the step-size controller in `error_control`.
 //!
 //! # References

@@ -26,6 +26,9 @@
 //! from the nodal mass matrix through the rigid-body and stretch modes
 //! ([`UndeformedInertia::from_nodal_mass`]), so a beam whose 12 × 12 matrices come from a file
 //! ([`crate::scene::matrix_file`]) gets exactly the same treatment.
+//!
+//! Over 600 lines: the spatial beam's inertia (full and frozen), its products, forces and energies
+//! share the shape integrals' private layout (its construction is `spatial_beam/build.rs`).
 
 use super::planar_element::GAUSS_4;
 use super::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};

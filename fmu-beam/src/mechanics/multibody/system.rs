@@ -2,6 +2,8 @@
 //!
 //! Residual of the equations of motion (what the integrator drives to zero):
 //! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
+//!
+//! Over 600 lines by its `Equations` impl, which forwards the trait to the methods above.
 
 use super::body::Body;
 use super::equations::Turning;

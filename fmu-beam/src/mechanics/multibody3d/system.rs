@@ -2,6 +2,10 @@
 //! norm rows first in g (one per body), then the joint rows. Built in code (the scene format
 //! for 3D comes later): add bodies, frames, joints and loads, then integrate it with
 //! [`crate::integrator`] through [`Equations`].
+//!
+//! Over 600 lines: the spatial system's residual, tangents, constraint rows and energy in one `impl
+//! System3` whose methods share private helpers (its builder is `build.rs`); a split like the
+//! planar `system/` is left for later.
 
 use super::body::{Body3, FRAME};
 use super::frame::Frame3;

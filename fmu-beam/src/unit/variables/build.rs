@@ -1,6 +1,9 @@
 //! The variables of a scene, in value-reference order: parameters (world, solver, beams,
 //! drives), inputs, then outputs (beams, shapes, joints, bodies, energy, solver, input loads'
 //! frames), each kind by its own function; only the variables of effects that are on.
+//!
+//! Over 600 lines on purpose: every variable a unit can offer, one function per kind in value-
+//! reference order; the list reads best whole.
 
 use super::{Binding, Causality, Initial, OutputKind, ParamTarget, VarType, Variability, Variable};
 use crate::scene::Scene;
