@@ -2,8 +2,6 @@
 //!
 //! Residual of the equations of motion (what the integrator drives to zero):
 //! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
-//!
-//! Over 600 lines by its `Equations` impl, which forwards the trait to the methods above.
 
 use super::body::Body;
 use super::equations::Turning;
@@ -141,36 +139,12 @@ impl System {
         self.frame_state(f1, q, None).phi - self.frame_state(f0, q, None).phi
     }
 
-    /// Number of coordinates.
-    pub fn n(&self) -> usize {
-        self.n
-    }
-
-    /// Number of constraint equations.
-    pub fn m(&self) -> usize {
-        self.m
-    }
-
-    /// The largest body length (m): the scale of position errors.
-    pub fn length_scale(&self) -> f64 {
-        self.bodies
-            .iter()
-            .map(Body::length_scale)
-            .fold(0.0, f64::max)
-            .max(1e-3)
-    }
-
     /// The flexible beam that is body `i`, if it is one.
     pub fn beam(&self, i: usize) -> Option<&PlanarBeam> {
         match &self.bodies[i] {
             Body::Beam(b) => Some(b),
             Body::Rigid(_) => None,
         }
-    }
-
-    /// Indices in q of the frame coordinates (x, y, θ) of every body, not its deformation.
-    pub fn frame_coordinates(&self) -> Vec<usize> {
-        self.offsets.iter().flat_map(|&o| o..o + 3).collect()
     }
 
     /// The unknowns that turn with the whole system: each body's (x, y) and angle, and the
@@ -227,16 +201,6 @@ impl System {
         (f0, f1, rows)
     }
 
-    /// Constraint residual g(q, t).
-    pub fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
-        for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, None, t);
-            for (k, r) in rows.iter().enumerate() {
-                g[j.row + k] = r.g;
-            }
-        }
-    }
-
     /// Adds J_pᵀ w + J_φ c of frame `f` into row `row` of `out`.
     fn add_row_jacobian(
         &self,
@@ -249,81 +213,6 @@ impl System {
         if let Some(b) = f.body {
             let o = self.offsets[b];
             f.for_each_jacobian(w, c, |k, x| out.add(row, o + k, x));
-        }
-    }
-
-    /// Coordinates of each body in q.
-    pub fn body_ranges(&self) -> Vec<Range<usize>> {
-        self.bodies
-            .iter()
-            .zip(&self.offsets)
-            .map(|(b, &o)| o..o + b.ndof())
-            .collect()
-    }
-
-    /// For each constraint row, the bodies of its joint's two frames.
-    pub fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
-        let mut rows = vec![[None, None]; self.m];
-        for j in &self.joints {
-            let body = |f: usize| match &self.frames[f] {
-                Frame::World { .. } => None,
-                Frame::OnBody { body, .. } => Some(*body),
-            };
-            let bodies = [body(j.frames[0]), body(j.frames[1])];
-            let count = Joint::rows_count(j.kind, j.drive.as_ref());
-            rows[j.row..j.row + count].fill(bodies);
-        }
-        rows
-    }
-
-    /// Constraint Jacobian G = ∂g/∂q by rows, overwritten.
-    pub fn jacobian_rows(&self, q: &DVector<f64>, t: f64, g: &mut JacobianRows) {
-        g.fill_zero();
-        for j in &self.joints {
-            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
-            for (k, r) in rows.iter().enumerate() {
-                self.add_row_jacobian(g, j.row + k, &f0, r.w0, r.c0);
-                self.add_row_jacobian(g, j.row + k, &f1, r.w1, r.c1);
-            }
-        }
-    }
-
-    /// Constraint residual g(q, t) and Jacobian G by rows (overwritten) in one pass over the
-    /// joints.
-    pub fn constraints_and_rows(
-        &self,
-        q: &DVector<f64>,
-        t: f64,
-        g: &mut DVector<f64>,
-        gm: &mut JacobianRows,
-    ) {
-        gm.fill_zero();
-        for j in &self.joints {
-            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
-            for (k, r) in rows.iter().enumerate() {
-                g[j.row + k] = r.g;
-                self.add_row_jacobian(gm, j.row + k, &f0, r.w0, r.c0);
-                self.add_row_jacobian(gm, j.row + k, &f1, r.w1, r.c1);
-            }
-        }
-    }
-
-    /// Acceleration bias: d²g/dt² = G q'' + bias.
-    pub fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
-        for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, Some(v), t);
-            for (k, r) in rows.iter().enumerate() {
-                out[j.row + k] = r.bias;
-            }
-        }
-    }
-
-    /// Mass matrix M(q) by body blocks, overwritten.
-    pub fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
-        m.fill_zero();
-        for (i, b) in self.bodies.iter().enumerate() {
-            let n = b.ndof();
-            b.mass_matrix(self.body_coords(i, q), m.blocks[i].view_mut((0, 0), (n, n)));
         }
     }
 
@@ -356,43 +245,6 @@ impl System {
         }
     }
 
-    /// Residual r(q, q', q'', t) without the reactions: inertia + internal - applied, overwritten.
-    pub fn body_residual(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        t: f64,
-        r: &mut DVector<f64>,
-    ) {
-        r.fill(0.0);
-        for (i, b) in self.bodies.iter().enumerate() {
-            let o = self.offsets[i];
-            let n = b.ndof();
-            b.residual(
-                self.body_coords(i, q),
-                self.body_coords(i, v),
-                self.body_coords(i, a),
-                self.gravity,
-                &mut r.as_mut_slice()[o..o + n],
-            );
-        }
-        for l in &self.loads {
-            let fs = self.frame_state(l.frame, q, None);
-            let (force, torque) = self.load_value(l, t);
-            self.add_generalized_force(r, &fs, force, torque);
-        }
-        for j in &self.joints {
-            if let Some(effort) = j.effort(t, &self.inputs) {
-                let f0 = self.frame_state(j.frames[0], q, Some(v));
-                let f1 = self.frame_state(j.frames[1], q, Some(v));
-                let c = j.coordinate(&f0, &f1);
-                self.add_generalized_force(r, &f0, c.w0 * effort, c.c0 * effort);
-                self.add_generalized_force(r, &f1, c.w1 * effort, c.c1 * effort);
-            }
-        }
-    }
-
     fn add_force_tangent(
         &self,
         kt: &mut BlockDiagonal,
@@ -410,48 +262,6 @@ impl System {
                 force,
                 kt.blocks[*body].view_mut((0, 0), (n, n)),
             );
-        }
-    }
-
-    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten. The terms
-    /// from the rotation of a prismatic axis and of effort drives are left out (Newton
-    /// converges without them); a reaction or load only acts on its own body's block.
-    pub fn tangent_blocks(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        kt: &mut BlockDiagonal,
-        ct: &mut BlockDiagonal,
-    ) {
-        kt.fill_zero();
-        ct.fill_zero();
-        for (i, b) in self.bodies.iter().enumerate() {
-            let n = b.ndof();
-            b.tangents(
-                self.body_coords(i, q),
-                self.body_coords(i, v),
-                self.body_coords(i, a),
-                self.gravity,
-                kt.blocks[i].view_mut((0, 0), (n, n)),
-                ct.blocks[i].view_mut((0, 0), (n, n)),
-            );
-        }
-        for j in &self.joints {
-            let (_, _, rows) = self.joint_rows(j, q, None, t);
-            for (k, r) in rows.iter().enumerate() {
-                if let Some(d) = r.force_dir {
-                    let l = lambda[j.row + k];
-                    self.add_force_tangent(kt, j.frames[1], q, d * l);
-                    self.add_force_tangent(kt, j.frames[0], q, -d * l);
-                }
-            }
-        }
-        for l in &self.loads {
-            let (force, _) = self.load_value(l, t);
-            self.add_force_tangent(kt, l.frame, q, -force);
         }
     }
 
@@ -474,50 +284,6 @@ impl System {
             total.add(b.counts());
         }
         total
-    }
-
-    /// Names of the joints whose equations are in the given constraint rows.
-    pub fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
-        let mut names: Vec<String> = Vec::new();
-        for &r in rows {
-            if let Some(j) = self.joints.iter().rev().find(|j| j.row <= r) {
-                if !names.contains(&j.name) {
-                    names.push(j.name.clone());
-                }
-            }
-        }
-        names
-    }
-
-    /// Times where a drive law jumps, for the integrator to land on.
-    pub fn breakpoints(&self) -> Vec<f64> {
-        let mut b: Vec<f64> = self
-            .joints
-            .iter()
-            .filter_map(|j| j.drive.as_ref())
-            .map(|d| &d.law)
-            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
-            .flat_map(TimeLaw::breakpoints)
-            .collect();
-        b.sort_by(|x, y| x.total_cmp(y));
-        b.dedup();
-        b
-    }
-
-    /// Power of drives and loads (W): Σ effort × joint rate + Σ F·ṗ + τ φ̇.
-    pub fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
-        let mut p = 0.0;
-        for (j, jt) in self.joints.iter().enumerate() {
-            if jt.drive.is_some() {
-                p += self.joint_effort(j, lambda, t) * self.joint_coordinate(j, q, v).1;
-            }
-        }
-        for l in &self.loads {
-            let fs = self.frame_state(l.frame, q, Some(v));
-            let (force, torque) = self.load_value(l, t);
-            p += force.dot(&fs.pd) + torque * fs.phid;
-        }
-        p
     }
 
     /// ∂Q/∂u of input `slot`: the generalized force of one unit of that input at (q, q', t),
@@ -585,14 +351,21 @@ impl System {
 }
 
 impl super::equations::Equations for System {
+    /// Number of coordinates.
     fn n(&self) -> usize {
-        System::n(self)
+        self.n
     }
+    /// Number of constraint equations.
     fn m(&self) -> usize {
-        System::m(self)
+        self.m
     }
+    /// The largest body length (m): the scale of position errors.
     fn length_scale(&self) -> f64 {
-        System::length_scale(self)
+        self.bodies
+            .iter()
+            .map(Body::length_scale)
+            .fold(0.0, f64::max)
+            .max(1e-3)
     }
     fn coordinate_kinds(&self) -> Vec<super::equations::CoordinateKind> {
         use super::equations::CoordinateKind;
@@ -604,21 +377,44 @@ impl super::equations::Equations for System {
         }
         kinds
     }
+    /// Indices in q of the frame coordinates (x, y, θ) of every body, not its deformation.
     fn frame_coordinates(&self) -> Vec<usize> {
-        System::frame_coordinates(self)
+        self.offsets.iter().flat_map(|&o| o..o + 3).collect()
     }
     fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
         System::initial_coordinates(self, scene)
     }
+    /// Coordinates of each body in q.
     fn body_ranges(&self) -> Vec<Range<usize>> {
-        System::body_ranges(self)
+        self.bodies
+            .iter()
+            .zip(&self.offsets)
+            .map(|(b, &o)| o..o + b.ndof())
+            .collect()
     }
+    /// For each constraint row, the bodies of its joint's two frames.
     fn row_bodies(&self) -> Vec<[Option<usize>; 2]> {
-        System::row_bodies(self)
+        let mut rows = vec![[None, None]; self.m];
+        for j in &self.joints {
+            let body = |f: usize| match &self.frames[f] {
+                Frame::World { .. } => None,
+                Frame::OnBody { body, .. } => Some(*body),
+            };
+            let bodies = [body(j.frames[0]), body(j.frames[1])];
+            let count = Joint::rows_count(j.kind, j.drive.as_ref());
+            rows[j.row..j.row + count].fill(bodies);
+        }
+        rows
     }
+    /// Mass matrix M(q) by body blocks, overwritten.
     fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
-        System::mass_blocks(self, q, m)
+        m.fill_zero();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let n = b.ndof();
+            b.mass_matrix(self.body_coords(i, q), m.blocks[i].view_mut((0, 0), (n, n)));
+        }
     }
+    /// Residual r(q, q', q'', t) without the reactions: inertia + internal - applied, overwritten.
     fn body_residual(
         &self,
         q: &DVector<f64>,
@@ -627,8 +423,36 @@ impl super::equations::Equations for System {
         t: f64,
         r: &mut DVector<f64>,
     ) {
-        System::body_residual(self, q, v, a, t, r)
+        r.fill(0.0);
+        for (i, b) in self.bodies.iter().enumerate() {
+            let o = self.offsets[i];
+            let n = b.ndof();
+            b.residual(
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
+                self.gravity,
+                &mut r.as_mut_slice()[o..o + n],
+            );
+        }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, None);
+            let (force, torque) = self.load_value(l, t);
+            self.add_generalized_force(r, &fs, force, torque);
+        }
+        for j in &self.joints {
+            if let Some(effort) = j.effort(t, &self.inputs) {
+                let f0 = self.frame_state(j.frames[0], q, Some(v));
+                let f1 = self.frame_state(j.frames[1], q, Some(v));
+                let c = j.coordinate(&f0, &f1);
+                self.add_generalized_force(r, &f0, c.w0 * effort, c.c0 * effort);
+                self.add_generalized_force(r, &f1, c.w1 * effort, c.c1 * effort);
+            }
+        }
     }
+    /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten. The terms
+    /// from the rotation of a prismatic axis and of effort drives are left out (Newton
+    /// converges without them); a reaction or load only acts on its own body's block.
     fn tangent_blocks(
         &self,
         q: &DVector<f64>,
@@ -639,14 +463,56 @@ impl super::equations::Equations for System {
         kt: &mut BlockDiagonal,
         ct: &mut BlockDiagonal,
     ) {
-        System::tangent_blocks(self, q, v, a, lambda, t, kt, ct)
+        kt.fill_zero();
+        ct.fill_zero();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let n = b.ndof();
+            b.tangents(
+                self.body_coords(i, q),
+                self.body_coords(i, v),
+                self.body_coords(i, a),
+                self.gravity,
+                kt.blocks[i].view_mut((0, 0), (n, n)),
+                ct.blocks[i].view_mut((0, 0), (n, n)),
+            );
+        }
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                if let Some(d) = r.force_dir {
+                    let l = lambda[j.row + k];
+                    self.add_force_tangent(kt, j.frames[1], q, d * l);
+                    self.add_force_tangent(kt, j.frames[0], q, -d * l);
+                }
+            }
+        }
+        for l in &self.loads {
+            let (force, _) = self.load_value(l, t);
+            self.add_force_tangent(kt, l.frame, q, -force);
+        }
     }
+    /// Constraint residual g(q, t).
     fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
-        System::constraints(self, q, t, g)
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
+            }
+        }
     }
-    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, gm: &mut JacobianRows) {
-        System::jacobian_rows(self, q, t, gm)
+    /// Constraint Jacobian G = ∂g/∂q by rows, overwritten.
+    fn jacobian_rows(&self, q: &DVector<f64>, t: f64, g: &mut JacobianRows) {
+        g.fill_zero();
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                self.add_row_jacobian(g, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(g, j.row + k, &f1, r.w1, r.c1);
+            }
+        }
     }
+    /// Constraint residual g(q, t) and Jacobian G by rows (overwritten) in one pass over the
+    /// joints.
     fn constraints_and_rows(
         &self,
         q: &DVector<f64>,
@@ -654,19 +520,65 @@ impl super::equations::Equations for System {
         g: &mut DVector<f64>,
         gm: &mut JacobianRows,
     ) {
-        System::constraints_and_rows(self, q, t, g, gm)
+        gm.fill_zero();
+        for j in &self.joints {
+            let (f0, f1, rows) = self.joint_rows(j, q, None, t);
+            for (k, r) in rows.iter().enumerate() {
+                g[j.row + k] = r.g;
+                self.add_row_jacobian(gm, j.row + k, &f0, r.w0, r.c0);
+                self.add_row_jacobian(gm, j.row + k, &f1, r.w1, r.c1);
+            }
+        }
     }
+    /// Acceleration bias: d²g/dt² = G q'' + bias.
     fn accel_bias(&self, q: &DVector<f64>, v: &DVector<f64>, t: f64, out: &mut DVector<f64>) {
-        System::accel_bias(self, q, v, t, out)
+        for j in &self.joints {
+            let (_, _, rows) = self.joint_rows(j, q, Some(v), t);
+            for (k, r) in rows.iter().enumerate() {
+                out[j.row + k] = r.bias;
+            }
+        }
     }
+    /// Times where a drive law jumps, for the integrator to land on.
     fn breakpoints(&self) -> Vec<f64> {
-        System::breakpoints(self)
+        let mut b: Vec<f64> = self
+            .joints
+            .iter()
+            .filter_map(|j| j.drive.as_ref())
+            .map(|d| &d.law)
+            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
+            .flat_map(TimeLaw::breakpoints)
+            .collect();
+        b.sort_by(|x, y| x.total_cmp(y));
+        b.dedup();
+        b
     }
+    /// Names of the joints whose equations are in the given constraint rows.
     fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {
-        System::joints_of_rows(self, rows)
+        let mut names: Vec<String> = Vec::new();
+        for &r in rows {
+            if let Some(j) = self.joints.iter().rev().find(|j| j.row <= r) {
+                if !names.contains(&j.name) {
+                    names.push(j.name.clone());
+                }
+            }
+        }
+        names
     }
+    /// Power of drives and loads (W): Σ effort × joint rate + Σ F·ṗ + τ φ̇.
     fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64 {
-        System::power(self, q, v, lambda, t)
+        let mut p = 0.0;
+        for (j, jt) in self.joints.iter().enumerate() {
+            if jt.drive.is_some() {
+                p += self.joint_effort(j, lambda, t) * self.joint_coordinate(j, q, v).1;
+            }
+        }
+        for l in &self.loads {
+            let fs = self.frame_state(l.frame, q, Some(v));
+            let (force, torque) = self.load_value(l, t);
+            p += force.dot(&fs.pd) + torque * fs.phid;
+        }
+        p
     }
     fn turning(&self) -> Option<Turning> {
         Some(System::turning(self))
