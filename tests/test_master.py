@@ -1,4 +1,4 @@
-"""`fmu-harness simulate` (the project's FMI master, fmu-harness/src/slave.rs) agrees with fmpy's
+"""`fmu-harness simulate` (the project's FMI master, fmu-harness/src/slave/mod.rs) agrees with fmpy's
 `simulate_fmu`: same unit, same stop time and communication step, so both drive the engine through
 the same calls and every output column must match to round-off (1e-12 relative to the value, or to
 the column's largest magnitude for entries near zero)."""

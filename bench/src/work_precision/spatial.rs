@@ -679,7 +679,7 @@ fn c6_lag(ends: &[(usize, Setting, f64)], reference: &[f64], moved: f64) -> Stri
          the twin's own time error and Newton's stopping error are larger than the lag. \
          Against the exact rigid pendulum, with the flexible runs converged by error control \
          at 1e-9, the lag is 3.7e-8 / 5.7e-8 / 6.2e-8 s for 1 / 2 / 4 elements \
-         (`c6_flexible_pendulum_lags_its_rigid_twin` in `fmu-beam/tests/spatial_system.rs`).\n\n\
+         (`c6_flexible_pendulum_lags_its_rigid_twin` in `fmu-beam/src/tests/spatial_system.rs`).\n\n\
          | elements |{}\n|---|{}\n",
         moved / rate.abs(),
         steps.iter().map(|s| format!(" {s} |")).collect::<String>(),
@@ -772,7 +772,7 @@ pub fn study(
              {C5_COMM} s): the mid-span point's distance from the exact one (relative: over L; \
              the main output), the tip's distance from the root (relative: over L) and |tip \
              rotation − 2π| (relative: over 2π), the last two CASES.md's pass criteria (1 %). The \
-             strong axis is left out of the timed sweep (`fmu-beam/tests/spatial_system.rs` \
+             strong axis is left out of the timed sweep (`fmu-beam/src/tests/spatial_system.rs` \
              closes both).\n\n{}",
             c5_findings(&points)
         );

@@ -277,7 +277,7 @@ pub struct BeamSpec {
     #[serde(default)]
     pub inertia: InertiaSpec,
     /// 3D: a one-element beam whose 12 × 12 mass and stiffness come from this file, relative
-    /// to the scene file (format: `fmu-beam/src/beam/matrix_file.rs`); the FMU carries its text.
+    /// to the scene file (format: `fmu-beam/src/scene/matrix_file.rs`); the FMU carries its text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_file: Option<String>,
     /// The matrix file's text (filled by [`Scene::load`]; written into the packaged scene).
