@@ -94,46 +94,7 @@ pub enum Command {
     },
     /// Draw a run as it moved: a self-contained HTML page (time slider, play/pause, speed,
     /// deformation magnification, a 3D view turned with the mouse) and/or an animated GIF.
-    Animate {
-        /// The run: a CSV of `simulate` or `cosim`, an FMU (run here with its
-        /// DefaultExperiment), or a scene file (run directly by the engine).
-        run: PathBuf,
-        /// The page to write (.html).
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// The animated GIF to write.
-        #[arg(long)]
-        gif: Option<PathBuf>,
-        /// The scene whose bodies and joints a CSV holds: a scene file or one of our FMUs;
-        /// `UNIT=FILE` for a cosim unit's outputs (`UNIT.<name>`). Repeatable.
-        #[arg(long)]
-        scene: Vec<String>,
-        /// GIF frames per second of playback.
-        #[arg(long, default_value_t = 25.0)]
-        fps: f64,
-        /// Simulated seconds per second of playback (0.25: four times slower than real time).
-        #[arg(long, default_value_t = 1.0)]
-        speed: f64,
-        /// Deformation magnification [default: the largest deflection shown as about 10 % of
-        /// its beam's length, at least 1].
-        #[arg(long)]
-        magnify: Option<f64>,
-        /// GIF size in pixels, WIDTHxHEIGHT.
-        #[arg(long, default_value = "640x480")]
-        size: String,
-        /// Stop time of a run made here [default: the DefaultExperiment's].
-        #[arg(long)]
-        stop: Option<f64>,
-        /// Communication step of a run made here [default: the DefaultExperiment's].
-        #[arg(long)]
-        step: Option<f64>,
-        /// Write the run made here (FMU or scene) as CSV.
-        #[arg(long)]
-        csv: Option<PathBuf>,
-        /// Write the GIF's geometry (frame times, magnification, world-to-pixel map) as JSON.
-        #[arg(long)]
-        metadata: Option<PathBuf>,
-    },
+    Animate(AnimateArgs),
 }
 
 /// Runs one command, writing its report to `out`.
@@ -152,36 +113,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
             csv,
         } => simulate_cmd(&fmu, stop, step, output, csv.as_deref(), out),
         Command::Cosim { system, csv } => cosim_cmd(&system, csv.as_deref(), out),
-        Command::Animate {
-            run,
-            output,
-            gif,
-            scene,
-            fps,
-            speed,
-            magnify,
-            size,
-            stop,
-            step,
-            csv,
-            metadata,
-        } => animate_cmd(
-            AnimateArgs {
-                run,
-                output,
-                gif,
-                scene,
-                fps,
-                speed,
-                magnify,
-                size,
-                stop,
-                step,
-                csv,
-                metadata,
-            },
-            out,
-        ),
+        Command::Animate(args) => animate_cmd(args, out),
         Command::Explain { scene } => explain_cmd(&scene, out),
         Command::Schema { output } => {
             write_text(&schema::scene_schema_text(), output.as_deref(), out)
@@ -265,19 +197,46 @@ fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(
     }
 }
 
-/// The options of `animate`, as [`Command::Animate`] holds them.
-struct AnimateArgs {
+/// The options of `animate`.
+#[derive(Debug, clap::Args)]
+pub struct AnimateArgs {
+    /// The run: a CSV of `simulate` or `cosim`, an FMU (run here with its
+    /// DefaultExperiment), or a scene file (run directly by the engine).
     run: PathBuf,
+    /// The page to write (.html).
+    #[arg(short, long)]
     output: Option<PathBuf>,
+    /// The animated GIF to write.
+    #[arg(long)]
     gif: Option<PathBuf>,
+    /// The scene whose bodies and joints a CSV holds: a scene file or one of our FMUs;
+    /// `UNIT=FILE` for a cosim unit's outputs (`UNIT.<name>`). Repeatable.
+    #[arg(long)]
     scene: Vec<String>,
+    /// GIF frames per second of playback.
+    #[arg(long, default_value_t = 25.0)]
     fps: f64,
+    /// Simulated seconds per second of playback (0.25: four times slower than real time).
+    #[arg(long, default_value_t = 1.0)]
     speed: f64,
+    /// Deformation magnification [default: the largest deflection shown as about 10 % of
+    /// its beam's length, at least 1].
+    #[arg(long)]
     magnify: Option<f64>,
+    /// GIF size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
     size: String,
+    /// Stop time of a run made here [default: the DefaultExperiment's].
+    #[arg(long)]
     stop: Option<f64>,
+    /// Communication step of a run made here [default: the DefaultExperiment's].
+    #[arg(long)]
     step: Option<f64>,
+    /// Write the run made here (FMU or scene) as CSV.
+    #[arg(long)]
     csv: Option<PathBuf>,
+    /// Write the GIF's geometry (frame times, magnification, world-to-pixel map) as JSON.
+    #[arg(long)]
     metadata: Option<PathBuf>,
 }
 
