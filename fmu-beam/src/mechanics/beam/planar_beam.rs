@@ -124,16 +124,26 @@ fn col2(m: &DMatrix<f64>, k: usize) -> Vector2<f64> {
 /// The assembled beam: constants of eq. (11) reduced to the kept deformation coordinates.
 #[derive(Debug, Clone)]
 pub struct PlanarBeam {
+    /// Name of the floating frame: the beam's, or that of one of its substructures.
     pub name: String,
+    /// Length of this floating frame (m).
     pub length: f64,
+    /// Number of equal finite elements over the length.
     pub elements: usize,
+    /// Where the floating frame sits (tangent at flange a, or through both ends): which nodal
+    /// coordinates are kept (§3.3).
     pub frame: FrameKind,
+    /// Section constants: area and second moment.
     pub section: Section,
     /// Mass per unit length ρA (kg/m), EA (N), EJ (N m^2).
     pub mu: f64,
+    /// Axial stiffness E·A (N).
     pub ea: f64,
+    /// Bending stiffness E·J (N m^2).
     pub ej: f64,
+    /// Mass-proportional Rayleigh coefficient α (1/s) of D_ff.
     pub rayleigh_alpha: f64,
+    /// Stiffness-proportional Rayleigh coefficient β (s) of D_ff.
     pub rayleigh_beta: f64,
     /// Full nodal indices (3 per node) kept by the boundary conditions of §3.3.
     pub kept: Vec<usize>,
@@ -153,10 +163,13 @@ pub struct PlanarBeam {
     pub mff: DMatrix<f64>,
     /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
     pub w: DMatrix<f64>,
+    /// K_ff, the linear stiffness matrix over the kept coordinates.
     pub kff: DMatrix<f64>,
     /// D_ff = alpha m_ff + beta K_ff.
     pub dff: DMatrix<f64>,
+    /// Flange a: the material point at the root (x = 0).
     pub flange_a: PointMap,
+    /// Flange b: the material point at the tip (x = length).
     pub flange_b: PointMap,
     /// Nonlinear axial strain ε = u' + v'²/2 (geometric stiffening), when on.
     pub geometric_stiffening: bool,
@@ -211,7 +224,7 @@ struct FullIntegrals {
 
 impl PlanarBeam {
     /// Builds the beam from its (validated) scene entry.
-    /// (Every term on, geometric stiffening as the scene entry says, no truncation.)
+    /// (Every term on; geometric stiffening and modal truncation as the scene entry says.)
     pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
         let options = BeamOptions {
             geometric_stiffening: spec.geometric_stiffening,
@@ -238,7 +251,8 @@ impl PlanarBeam {
         )
     }
 
-    /// The full model (every term on, no truncation).
+    /// The full model: the terms of [`BeamOptions::default`] (all but geometric stiffening),
+    /// no truncation.
     pub fn new(
         name: &str,
         length: f64,
@@ -264,6 +278,8 @@ impl PlanarBeam {
         )
     }
 
+    /// The beam computing the terms of `options` (on `options.modes` modes when set), of
+    /// density `rho` (kg/m^3) and Young's modulus `e` (Pa).
     #[allow(clippy::too_many_arguments)]
     pub fn with_options(
         name: &str,
@@ -753,6 +769,8 @@ impl PlanarBeam {
         map
     }
 
+    /// Switches geometric stiffening (the nonlinear axial strain) on or off; `options` keeps
+    /// the value the beam was built with.
     pub fn set_geometric_stiffening(&mut self, on: bool) {
         self.geometric_stiffening = on;
     }

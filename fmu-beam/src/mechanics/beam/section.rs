@@ -29,6 +29,7 @@ impl Section {
         }
     }
 
+    /// Solid rectangle of height a (in the plane of bending) and width b (m).
     pub fn rectangle(a: f64, b: f64) -> Section {
         Section {
             area: a * b,
@@ -45,6 +46,7 @@ impl Section {
         }
     }
 
+    /// Solid circle of diameter d (m).
     pub fn circle(d: f64) -> Section {
         Section {
             area: PI * d * d / 4.0,
