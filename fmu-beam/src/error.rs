@@ -4,46 +4,82 @@
 use crate::scene::SceneError;
 use thiserror::Error;
 
+/// Why the engine refused a call or a step; [`EngineError::is_discard`] tells a step the master
+/// may retry (fmi2Discard) from an error of use or input (fmi2Error).
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EngineError {
     /// Boxed: a refusal carries four texts, and every step's `Result` would carry their size.
     #[error(transparent)]
     Scene(Box<SceneError>),
+    /// The initial state cannot be built: redundant constraints, or a mass matrix singular on
+    /// the motions the joints leave free.
     #[error("initial state: {message}")]
-    InitialState { message: String },
+    InitialState {
+        /// What is wrong, with the joints or the time concerned.
+        message: String,
+    },
     #[error(
         "the mechanism cannot be assembled at t = {t} s: constraint residual {residual:.3e} \
          of joint(s) {joints} stays above {tolerance:.1e} after {iterations} iterations"
     )]
+    /// No placement of the bodies closes the joints: the Gauss–Newton assembly on the frame
+    /// coordinates did not bring g(q) to zero.
     Assembly {
+        /// Time of the assembly (s).
         t: f64,
+        /// Largest |gᵢ(q)| left, in its row's unit (m for a position; rad, or 1 for a
+        /// quaternion's norm, for an orientation).
         residual: f64,
+        /// The joints of the rows still above the tolerance, comma-separated.
         joints: String,
+        /// The residual asked for: 10⁻¹² × max(the system's length scale, 1 m).
         tolerance: f64,
+        /// Gauss–Newton iterations done.
         iterations: usize,
     },
     #[error(
         "Newton iteration did not converge at t = {t} s with step {h:.3e} s: {iterations} \
          iterations, last correction {correction:.3e} (1 = tolerance)"
     )]
+    /// Newton's iteration failed at every step size down to the smallest.
     NewtonNotConverged {
+        /// Time at the start of the failed step (s).
         t: f64,
+        /// Size of the last step tried (s).
         h: f64,
+        /// Newton iterations of that step.
         iterations: usize,
+        /// Weighted norm of its last correction, in units of the tolerance (1 = tolerance).
         correction: f64,
     },
     #[error("the iteration matrix is singular at t = {t} s (step {h:.3e} s)")]
-    SingularMatrix { t: f64, h: f64 },
+    /// The iteration matrix is singular: in a step, at every size down to the smallest; or at
+    /// a jump of a law, where the jump of the accelerations is solved for.
+    SingularMatrix {
+        /// Time at the start of the failed step, or of the jump (s).
+        t: f64,
+        /// Size of the last step tried, or of the step that met the jump (s).
+        h: f64,
+    },
     #[error("the state became non-finite (NaN or infinite) at t = {t} s")]
-    NonFinite { t: f64 },
+    /// Newton's iterate became NaN or infinite, down to the smallest step.
+    NonFinite {
+        /// Time at the start of the failed step (s).
+        t: f64,
+    },
     #[error(
         "the step size fell to {h:.3e} s at t = {t} s, below the minimum {h_min:.3e} s: \
          the solution is not resolvable at tolerance {tolerance:.1e}"
     )]
+    /// The step size fell below the smallest the stepper takes (or a step rounded away).
     StepTooSmall {
+        /// Time at the start of the refused step (s).
         t: f64,
+        /// The step size refused, or the one that was to be tried next (s).
         h: f64,
+        /// The smallest step: 10⁻¹² × max(|end time|, 1 s) (s).
         h_min: f64,
+        /// The solver's relative tolerance (1), `solver.tolerance`.
         tolerance: f64,
     },
     #[error(
@@ -52,10 +88,16 @@ pub enum EngineError {
          above its first bending frequency softens without bound); use (more) substructures or \
          geometric_stiffening"
     )]
+    /// A floating frame's transverse deflection exceeds its length: the linear model has run
+    /// away.
     Runaway {
+        /// Name of the floating frame: the beam's, or that of one of its substructures.
         beam: String,
+        /// Time at which the deflection was seen (s).
         t: f64,
+        /// The frame's largest transverse deflection (m).
         deflection: f64,
+        /// The frame's length (m).
         length: f64,
     },
     #[error(
@@ -63,43 +105,92 @@ pub enum EngineError {
          its length {length} m: the linear frames have stretched, the model is out of its range \
          (more substructures, or geometric_stiffening for a spinning beam)"
     )]
+    /// A beam's chord (root to tip) is more than 1 % longer than the beam.
     Stretched {
+        /// Name of the beam in the scene.
         beam: String,
+        /// Time at which the chord was measured (s).
         t: f64,
+        /// Distance from the beam's root to its tip (m).
         chord: f64,
+        /// The beam's length (m).
         length: f64,
     },
     #[error("unknown value reference {vr} for a variable of type {ty}")]
-    UnknownValueReference { vr: u32, ty: &'static str },
+    /// No variable of this type has this value reference.
+    UnknownValueReference {
+        /// The FMI value reference asked for.
+        vr: u32,
+        /// The type of the get or set call: "Real", "Integer" or "Boolean".
+        ty: &'static str,
+    },
     #[error("variable '{name}' cannot be set now: {reason}")]
-    NotSettable { name: String, reason: String },
-    #[error("variable '{name}': value {value} is not a finite number")]
-    NonFiniteValue { name: String, value: f64 },
-    #[error("variable '{name}': value {value} is not allowed: {rule}")]
-    InvalidValue {
+    /// The variable exists but may not be set now (not a parameter or input, or a fixed
+    /// parameter after initialization).
+    NotSettable {
+        /// The variable's name in the model description.
         name: String,
+        /// Why it cannot be set.
+        reason: String,
+    },
+    #[error("variable '{name}': value {value} is not a finite number")]
+    /// A value set was NaN or infinite.
+    NonFiniteValue {
+        /// The variable's name in the model description.
+        name: String,
+        /// The value refused, in the variable's unit.
         value: f64,
+    },
+    #[error("variable '{name}': value {value} is not allowed: {rule}")]
+    /// A finite value that the scene's rules refuse (or an input derivative order other
+    /// than 1 or 2).
+    InvalidValue {
+        /// The variable's name in the model description.
+        name: String,
+        /// The value refused, in the variable's unit (the order, for an input derivative).
+        value: f64,
+        /// The rule it breaks, as the scene's validation states it.
         rule: String,
     },
     #[error("doStep: {message}")]
-    BadStep { message: String },
+    /// A doStep call the instance cannot take: not initialized, a step size not positive and
+    /// finite, or a communication point other than the instance's time.
+    BadStep {
+        /// Which, with the numbers.
+        message: String,
+    },
     #[error("FMU state: {message}")]
-    BadState { message: String },
+    /// A serialized FMU state that cannot be read back (truncated, inconsistent, non-finite).
+    BadState {
+        /// What is wrong with the bytes.
+        message: String,
+    },
     #[error(
         "{role} value reference {vr}{}: {reason}",
         .name.as_ref().map(|n| format!(" ('{n}')")).unwrap_or_default()
     )]
+    /// A directional-derivative request names a reference that is not a Real output (an
+    /// unknown) or a Real input (a known).
     DirectionalDerivative {
+        /// The value reference refused.
         vr: u32,
+        /// Its role in the request: "unknown" or "known".
         role: &'static str,
+        /// The variable's name, when a variable has this reference.
         name: Option<String>,
+        /// Why it is refused.
         reason: String,
     },
     #[error(
         "the accelerations at t = {t} s are not determined by the inputs: [[M, G^T], [G, 0]] is \
          singular (a body without mass or inertia that the joints do not hold)"
     )]
-    FeedthroughSingular { t: f64 },
+    /// [[M, Gᵀ], [G, 0]] is singular: the inputs do not determine the accelerations, so the
+    /// outputs' feedthrough (consistent accelerations, directional derivatives) is undefined.
+    FeedthroughSingular {
+        /// Time of the state at which the matrix was factorized (s).
+        t: f64,
+    },
 }
 
 impl EngineError {

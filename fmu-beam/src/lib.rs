@@ -12,6 +12,7 @@
 //! table, the effects it resolves), and, for those who assemble systems without a scene (the
 //! benchmarks), the curated [`mechanics`] and [`integrator`] modules. Everything else is
 //! private to the crate.
+#![warn(missing_docs)]
 
 mod error;
 mod fmi2;

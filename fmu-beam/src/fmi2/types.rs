@@ -4,8 +4,13 @@
 //! Enumerations that the master passes *in* (`fmi2Type`, `fmi2StatusKind`) are plain `c_int`s
 //! with named constants: a Rust enum must never hold a value outside its variants, and a master
 //! may send any integer.
+//!
+//! Each name is the FMI 2.0 standard's and means what the standard documents for it (its
+//! §2.1, and the two headers): `missing_docs` is allowed here rather than repeating the
+//! standard on every name; a doc comment says only where the Rust form needs a word.
 
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
+#![allow(missing_docs)]
 
 use std::os::raw::{c_char, c_int, c_uint, c_void};
 

@@ -21,7 +21,9 @@ pub enum LinearSolver {
     /// Dense or sparse, by the system's size ([`prefers_sparse`]).
     #[default]
     Auto,
+    /// nalgebra's dense LU with partial pivoting, at every size.
     Dense,
+    /// faer's sparse LU (ordering and symbolic analysis once per system), at every size.
     Sparse,
 }
 

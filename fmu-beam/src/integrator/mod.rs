@@ -23,13 +23,19 @@ pub(crate) use codec::{write_vec, Reader};
 /// Solver settings (all tunable between communication steps).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
+    /// Local error control (true) or a fixed internal step of `max_step` (false).
     pub adaptive: bool,
+    /// Relative tolerance (1) of the error control and of Newton's iteration, on each
+    /// coordinate against tol × (|q| + the system's length; 1 rad for angles).
     pub tolerance: f64,
+    /// Largest internal step (s); the fixed step when not `adaptive`.
     pub max_step: f64,
+    /// Spectral radius at infinity ρ∞ of generalized-α (1): 1 = no numerical damping.
     pub rho_inf: f64,
 }
 
 impl Settings {
+    /// The settings of the scene's `solver` entry.
     pub fn from_scene(scene: &Scene) -> Settings {
         Settings {
             adaptive: scene.solver.adaptive,
@@ -43,9 +49,14 @@ impl Settings {
 /// Work counters since initialization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Stats {
+    /// Internal steps accepted.
     pub steps: u64,
+    /// Newton corrections solved for, over accepted and refused steps.
     pub newton_iterations: u64,
+    /// Iteration matrices evaluated and factorized.
     pub jacobians: u64,
+    /// Steps refused and retried smaller: an error estimate above the tolerance, a singular
+    /// matrix, a non-finite iterate, or Newton not converging with a fresh matrix.
     pub rejected: u64,
     /// Fixed steps cut short (to land, or after a failed Newton iteration).
     pub split: u64,

@@ -14,10 +14,12 @@ use crate::scene::Scene;
 use nalgebra::DVector;
 use std::ops::Range;
 
+/// The system a scene builds, planar or spatial, as one [`Equations`].
 #[derive(Debug, Clone)]
 pub enum Mechanics {
     /// The planar system, with the planar scene it was built from.
     Planar(System, Box<Scene>),
+    /// The spatial system, with where the scene's parts are in it.
     Spatial(System3, SceneIndex),
 }
 
@@ -46,10 +48,12 @@ impl Mechanics {
         }
     }
 
+    /// The FMU inputs as the system holds them, by input slot.
     pub fn inputs(&self) -> &[InputValue] {
         each!(self, s => &s.inputs)
     }
 
+    /// The FMU inputs, to set (the unit writes each input and its derivatives here).
     pub fn inputs_mut(&mut self) -> &mut Vec<InputValue> {
         each!(self, s => &mut s.inputs)
     }

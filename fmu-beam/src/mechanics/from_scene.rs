@@ -36,7 +36,7 @@ impl Section {
 
 impl PlanarBeam {
     /// Builds the beam from its (validated) scene entry.
-    /// (Every term on, geometric stiffening as the scene entry says, no truncation.)
+    /// (Every term on; geometric stiffening and modal truncation as the scene entry says.)
     pub fn from_spec(spec: &BeamSpec) -> PlanarBeam {
         let options = BeamOptions {
             geometric_stiffening: spec.geometric_stiffening,

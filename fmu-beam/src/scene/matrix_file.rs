@@ -44,7 +44,9 @@ pub const RIGID_TOLERANCE: f64 = 1e-9;
 pub struct MatrixFile {
     /// Distance between the two nodes (m).
     pub length: f64,
+    /// The 12 × 12 nodal mass matrix of the free beam (kg, kg m, kg m^2 by coordinate pair).
     pub mass: DMatrix<f64>,
+    /// The 12 × 12 nodal stiffness matrix of the free beam (N/m, N, N m by coordinate pair).
     pub stiffness: DMatrix<f64>,
 }
 
@@ -52,16 +54,33 @@ pub struct MatrixFile {
 /// 1-based, as a reader counts.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MatrixFileError {
+    /// The file cannot be read.
     #[error("{file}: cannot read the matrix file: {message}")]
-    Io { file: String, message: String },
+    Io {
+        /// The file, as the caller named it.
+        file: String,
+        /// The system's error.
+        message: String,
+    },
+    /// A line that breaks the format (an unknown keyword, a row of other than 12 numbers, a
+    /// block or `length` given twice, …).
     #[error("{file}:{line}: {rule}")]
     Syntax {
+        /// The file, as the caller named it.
         file: String,
+        /// The offending line (1-based).
         line: usize,
+        /// What the format asks for there.
         rule: String,
     },
+    /// The file ends with `length`, a block, or rows of a block missing.
     #[error("{file}: {rule}")]
-    Incomplete { file: String, rule: String },
+    Incomplete {
+        /// The file, as the caller named it.
+        file: String,
+        /// What is missing.
+        rule: String,
+    },
     #[error(
         "{file}:{line}: the {block} matrix must be symmetric: entry (row {r}, column {c}) = \
          {a:e} but (row {c}, column {r}) = {b:e}, apart by more than {tolerance:e} × the largest \
@@ -69,27 +88,45 @@ pub enum MatrixFileError {
         r = row + 1,
         c = col + 1
     )]
+    /// A matrix is not symmetric to within [`SYMMETRY_TOLERANCE`] of its largest entry.
     NotSymmetric {
+        /// The file, as the caller named it.
         file: String,
+        /// The line of row `row` (1-based).
         line: usize,
+        /// Which matrix: "mass" or "stiffness".
         block: &'static str,
+        /// Row of the first asymmetric entry found (0-based; above the diagonal).
         row: usize,
+        /// Its column (0-based).
         col: usize,
+        /// Entry (row, col), in the matrix's unit for that coordinate pair.
         a: f64,
+        /// Entry (col, row), its mirror.
         b: f64,
+        /// The largest |entry| of the matrix.
         largest: f64,
+        /// The relative tolerance, [`SYMMETRY_TOLERANCE`].
         tolerance: f64,
     },
     #[error(
         "{file}:{line}: the {block} matrix must be positive semi-definite: eigenvalue \
          {eigenvalue:e} is below −{tolerance:e} × the largest eigenvalue {largest:e}"
     )]
+    /// A matrix has a negative eigenvalue beyond rounding: a mass or a stiffness that gives
+    /// energy back.
     NotPositiveSemiDefinite {
+        /// The file, as the caller named it.
         file: String,
+        /// The line of the block's keyword (1-based).
         line: usize,
+        /// Which matrix: "mass" or "stiffness".
         block: &'static str,
+        /// The smallest eigenvalue of the matrix's symmetric part.
         eigenvalue: f64,
+        /// The largest eigenvalue.
         largest: f64,
+        /// The relative tolerance, [`EIGEN_TOLERANCE`].
         tolerance: f64,
     },
     #[error(
@@ -97,12 +134,20 @@ pub enum MatrixFileError {
          the {motion} gives forces up to {force:e}, above {limit:e} ({tolerance:e} × largest \
          entry × mode size)"
     )]
+    /// The stiffness gives forces for a rigid motion of the free beam.
     RigidMotionStrained {
+        /// The file, as the caller named it.
         file: String,
+        /// The line of the `stiffness` keyword (1-based).
         line: usize,
+        /// Which rigid motion: "translation along x" … "rotation about z" (about node a).
         motion: &'static str,
+        /// The largest nodal force or moment |(K φ)ᵢ| (N or N m) of the motion's mode φ (a
+        /// translation of 1 m, or a rotation of 1 rad).
         force: f64,
+        /// The force allowed: tolerance × the largest |entry| of K × the largest |φ|.
         limit: f64,
+        /// The relative tolerance, [`RIGID_TOLERANCE`].
         tolerance: f64,
     },
 }

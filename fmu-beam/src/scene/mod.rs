@@ -78,7 +78,9 @@ pub struct Scene {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(untagged)]
 pub enum EffectsSpec {
+    /// `"all"` (the full model) or `"auto"` (the generator decides from the scene).
     Mode(String),
+    /// The effects to simulate, by name; those not listed are off.
     List(Vec<String>),
 }
 
@@ -528,6 +530,7 @@ pub struct JointSpec {
     pub drive: Option<DriveSpec>,
 }
 
+/// How a joint constrains its two frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
@@ -551,10 +554,12 @@ pub struct DriveSpec {
     /// prismatic joint, acts across the joint). A motion drive's law gives the coordinate
     /// (rad or m), an effort drive's the torque (N m) or force (N).
     pub kind: DriveKind,
+    /// The law and its parameters, written beside `kind` (`law`, `value`, …).
     #[serde(flatten)]
     pub law: LawSpec,
 }
 
+/// What a drive's law sets: the joint coordinate, or the effort across the joint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
@@ -694,6 +699,7 @@ impl Scene {
         }
     }
 
+    /// The beam named `name`.
     pub fn beam(&self, name: &str) -> Option<&BeamSpec> {
         self.beams.iter().find(|b| b.name == name)
     }

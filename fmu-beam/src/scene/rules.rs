@@ -70,7 +70,9 @@ pub struct Rule {
     pub fields: &'static [&'static str],
     /// The message's rule (some messages add the values that decided it).
     pub text: &'static str,
+    /// The scenes it applies to: planar, 3D or both.
     pub dims: Dims,
+    /// Its JSON-Schema form, if it has one.
     pub schema: Schema,
 }
 

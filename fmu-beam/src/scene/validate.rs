@@ -10,15 +10,33 @@ use thiserror::Error;
 /// Why a scene was refused.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SceneError {
+    /// The scene file, or a beam's matrix file, cannot be read.
     #[error("{origin}: cannot read the scene: {message}")]
-    Io { origin: String, message: String },
+    Io {
+        /// The scene file's path (and, for a matrix file, the field that names it).
+        origin: String,
+        /// The system's error.
+        message: String,
+    },
+    /// The text is not TOML, or not of the scene's shape (unknown field, wrong type, …).
     #[error("{origin}: {message}")]
-    Parse { origin: String, message: String },
+    Parse {
+        /// Where the text came from: a path, or what the caller named it.
+        origin: String,
+        /// The TOML parser's message, with its line and column.
+        message: String,
+    },
+    /// A value that breaks one of the scene's rules ([`Rule`]).
     #[error("{origin}: field `{field}` = {value}: {rule}")]
     Invalid {
+        /// Where the scene came from: a path, or what the caller named it ("parameters" for
+        /// values set on an instance).
         origin: String,
+        /// The field's path in the scene, such as `beam[0].material.e`.
         field: String,
+        /// The value refused, as written (a number in the field's unit).
         value: String,
+        /// The rule's text, with the values that decided it when there are some.
         rule: String,
         /// The [`Rule::code`] of the rule (`rules::RULES`).
         code: &'static str,

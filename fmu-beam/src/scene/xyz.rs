@@ -10,10 +10,12 @@ use std::fmt;
 pub mod point {
     use super::*;
 
+    /// Writes the 3 numbers.
     pub fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
         serde::Serialize::serialize(v, s)
     }
 
+    /// Reads 2 numbers (z = 0) or 3.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
         d.deserialize_seq(Xyz { scalar: false })
     }
@@ -23,10 +25,12 @@ pub mod point {
 pub mod about_z {
     use super::*;
 
+    /// Writes the 3 numbers.
     pub fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
         serde::Serialize::serialize(v, s)
     }
 
+    /// Reads a number n as `[0, 0, n]`, or 3 numbers.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
         d.deserialize_any(Xyz { scalar: true })
     }
@@ -36,10 +40,12 @@ pub mod about_z {
 pub mod direction {
     use super::*;
 
+    /// Writes the 3 numbers (the fields that use it skip `None`).
     pub fn serialize<S: Serializer>(v: &Option<[f64; 3]>, s: S) -> Result<S::Ok, S::Error> {
         serde::Serialize::serialize(v, s)
     }
 
+    /// Reads 3 numbers (2 are taken as z = 0, as for a point).
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 3]>, D::Error> {
         d.deserialize_seq(Xyz { scalar: false }).map(Some)
     }

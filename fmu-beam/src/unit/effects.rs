@@ -37,11 +37,13 @@ pub const AXIAL_SHARE: f64 = 0.01;
 /// One resolved effect of one subject (the scene, or a beam), with its reason.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Decision {
+    /// The effect's name: one of [`EFFECTS`], or `formulation` (planar or spatial element).
     pub effect: &'static str,
     /// `scene` or the beam's name.
     pub subject: String,
     /// `on`, `off`, or a setting (`4 modes`, `5 x 4 elements`).
     pub setting: String,
+    /// The reason, as `fmu-harness explain` prints it.
     pub why: String,
     /// Estimated share of a step's cost that this effect adds (0..1): the operation count with
     /// it, less the count without it, over the count with every resolved effect.
@@ -53,7 +55,9 @@ pub struct Decision {
 pub struct Resolution {
     /// `all`, `auto` or `list`.
     pub mode: &'static str,
+    /// What the system is built to compute.
     pub effects: Effects,
+    /// The decisions: the scene's first (a 3D scene's formulation, gravity), then each beam's.
     pub decisions: Vec<Decision>,
 }
 

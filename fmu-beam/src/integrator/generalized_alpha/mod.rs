@@ -30,15 +30,21 @@ pub use error_control::Controller;
 /// The integration state at a step boundary.
 #[derive(Debug, PartialEq)]
 pub struct GaState {
+    /// Time (s).
     pub t: f64,
     /// Proposed size of the next internal step (adaptive mode).
     pub h: f64,
+    /// Generalized coordinates q: each body's frame position and orientation, then its
+    /// elastic coordinates.
     pub q: DVector<f64>,
+    /// Velocities q'.
     pub v: DVector<f64>,
     /// Algorithmic acceleration a of the generalized-α scheme.
     pub acc: DVector<f64>,
     /// True acceleration q''.
     pub qdd: DVector<f64>,
+    /// Lagrange multipliers λ, one per constraint row: the reactions Gᵀλ in
+    /// M q'' + Gᵀλ = Q.
     pub lambda: DVector<f64>,
     /// Work done by drives and loads since the start (J), trapezoidal in time.
     pub work: f64,
@@ -277,6 +283,8 @@ impl SplitReason {
 /// Newton iterations, internal steps and communication steps while it converges well.
 #[derive(Debug, Clone)]
 pub struct Stepper {
+    /// The settings in force; change them by [`Stepper::set_settings`], which drops what
+    /// depends on them.
     pub settings: Settings,
     /// Error weight scale of each coordinate (length for translations, 1 for angles).
     scale: DVector<f64>,

@@ -127,16 +127,26 @@ fn col2(m: &DMatrix<f64>, k: usize) -> Vector2<f64> {
 /// The assembled beam: constants of eq. (11) reduced to the kept deformation coordinates.
 #[derive(Debug, Clone)]
 pub struct PlanarBeam {
+    /// Name of the floating frame: the beam's, or that of one of its substructures.
     pub name: String,
+    /// Length of this floating frame (m).
     pub length: f64,
+    /// Number of equal finite elements over the length.
     pub elements: usize,
+    /// Where the floating frame sits (tangent at flange a, or through both ends): which nodal
+    /// coordinates are kept (§3.3).
     pub frame: FloatingFrame,
+    /// Section constants: area and second moment.
     pub section: Section,
     /// Mass per unit length ρA (kg/m), EA (N), EJ (N m^2).
     pub mu: f64,
+    /// Axial stiffness E·A (N).
     pub ea: f64,
+    /// Bending stiffness E·J (N m^2).
     pub ej: f64,
+    /// Mass-proportional Rayleigh coefficient α (1/s) of D_ff.
     pub rayleigh_alpha: f64,
+    /// Stiffness-proportional Rayleigh coefficient β (s) of D_ff.
     pub rayleigh_beta: f64,
     /// Full nodal indices (3 per node) kept by the boundary conditions of §3.3.
     pub kept: Vec<usize>,
@@ -156,10 +166,13 @@ pub struct PlanarBeam {
     pub mff: DMatrix<f64>,
     /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
     pub w: DMatrix<f64>,
+    /// K_ff, the linear stiffness matrix over the kept coordinates.
     pub kff: DMatrix<f64>,
     /// D_ff = alpha m_ff + beta K_ff.
     pub dff: DMatrix<f64>,
+    /// Flange a: the material point at the root (x = 0).
     pub flange_a: PointMap,
+    /// Flange b: the material point at the tip (x = length).
     pub flange_b: PointMap,
     /// Nonlinear axial strain ε = u' + v'²/2 (geometric stiffening), when on.
     pub geometric_stiffening: bool,

@@ -13,6 +13,7 @@ pub struct Section {
 }
 
 impl Section {
+    /// Solid rectangle of height a (in the plane of bending) and width b (m).
     pub fn rectangle(a: f64, b: f64) -> Section {
         Section {
             area: a * b,
@@ -29,6 +30,7 @@ impl Section {
         }
     }
 
+    /// Solid circle of diameter d (m).
     pub fn circle(d: f64) -> Section {
         Section {
             area: PI * d * d / 4.0,

@@ -76,15 +76,22 @@ pub struct SpatialBeamProps {
     pub length: f64,
     /// Elements in one floating frame.
     pub elements: usize,
+    /// Where each floating frame sits (tangent at flange a, or through both ends): which
+    /// nodal coordinates it removes (`kept_coordinates`).
     pub frame: FloatingFrame,
     /// Density ρ (kg/m^3), Young's modulus E and shear modulus G (Pa).
     pub rho: f64,
+    /// Young's modulus E (Pa): axial and bending stiffness E A, E I_y, E I_z.
     pub e: f64,
+    /// Shear modulus G (Pa): torsional stiffness G J_t.
     pub g: f64,
+    /// Section constants: area, second moments, torsion constant, polar moment.
     pub section: SpatialSection,
     /// D_ff = alpha m_ff + beta K_ff.
     pub rayleigh_alpha: f64,
+    /// Stiffness-proportional Rayleigh coefficient β (s) of D_ff.
     pub rayleigh_beta: f64,
+    /// How the inertia terms are evaluated (full or frozen at q_f = 0).
     pub inertia: InertiaModel,
 }
 
@@ -275,12 +282,20 @@ impl UndeformedInertia {
 /// The assembled beam in one floating frame.
 #[derive(Debug, Clone)]
 pub struct SpatialBeam {
+    /// Name of the floating frame: the beam's, or `<beam>.<i>` for substructure i.
     pub name: String,
+    /// Length of this floating frame (m).
     pub length: f64,
+    /// Equal elements over the length (1 for a beam from a matrix file).
     pub elements: usize,
+    /// Where the floating frame sits: which nodal coordinates are kept.
     pub frame: FloatingFrame,
+    /// How the inertia terms are evaluated; always [`InertiaModel::Frozen`] without shape
+    /// integrals ([`SpatialBeam::set_inertia`]).
     pub inertia: InertiaModel,
+    /// Mass-proportional Rayleigh coefficient α (1/s): D_ff = α m_ff + β K_ff.
     pub rayleigh_alpha: f64,
+    /// Stiffness-proportional Rayleigh coefficient β (s).
     pub rayleigh_beta: f64,
     /// Full nodal indices (6 per node) kept by the frame's boundary conditions.
     pub kept: Vec<usize>,
@@ -288,12 +303,17 @@ pub struct SpatialBeam {
     pub mass: f64,
     /// Shape integrals of the full model (`None` for a beam from a matrix file).
     pub integrals: Option<ShapeIntegrals>,
+    /// Inertia of the undeformed beam from its nodal mass matrix: what the frozen model uses.
     pub undeformed: UndeformedInertia,
     /// m_ff (with the torsion rotary inertia), K_ff, D_ff over the kept coordinates.
     pub mff: DMatrix<f64>,
+    /// K_ff, the stiffness matrix over the kept coordinates.
     pub kff: DMatrix<f64>,
+    /// D_ff = α m_ff + β K_ff, the Rayleigh damping matrix.
     pub dff: DMatrix<f64>,
+    /// Flange a: the material point at the root (x = 0).
     pub flange_a: SpatialPointMap,
+    /// Flange b: the material point at the tip (x = length).
     pub flange_b: SpatialPointMap,
 }
 

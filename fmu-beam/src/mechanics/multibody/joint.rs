@@ -91,9 +91,13 @@ impl std::ops::Deref for Rows {
     }
 }
 
+/// A joint's drive: its coordinate follows the law (motion) or a torque or force given by the
+/// law acts across it (effort).
 #[derive(Debug, Clone)]
 pub struct Drive {
+    /// Motion (a constraint row on the joint coordinate) or effort (a generalized force).
     pub kind: DriveKind,
+    /// The joint coordinate (rad or m) or the effort (N·m or N) as a function of time.
     pub law: TimeLaw,
 }
 

@@ -7,9 +7,14 @@ use std::f64::consts::PI;
 /// set with fmi2SetRealInputDerivatives: u(t) = u0 + u1 (t - t0) + u2 (t - t0)^2 / 2.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct InputValue {
+    /// u0, the value set at `t0` (the input variable's unit).
     pub value: f64,
+    /// u1, its first time derivative (unit/s), from fmi2SetRealInputDerivatives; setting the
+    /// value resets it to 0.
     pub der1: f64,
+    /// u2, its second time derivative (unit/s²), likewise.
     pub der2: f64,
+    /// Time the value and derivatives were set at (s).
     pub t0: f64,
 }
 
@@ -28,26 +33,36 @@ impl InputValue {
     }
 }
 
+/// A function of time that drives a joint or scales a load, in the unit of what it drives (rad
+/// or m, N·m or N; a factor for a load's scale).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Law {
+    /// This value at all times.
     Constant(f64),
     /// value (1 - exp(-t/tau)), zero after `until`.
     Exponential {
+        /// The final value, approached as t → ∞.
         value: f64,
+        /// Time constant τ (s).
         tau: f64,
     },
     /// Planar paper eq. (18).
     SpinUp {
+        /// Final angular speed (rad/s), reached at the end of the ramp.
         omega: f64,
+        /// Duration of the ramp (s); the speed is constant after it.
         ramp: f64,
     },
+    /// Rows [t (s), value], interpolated linearly, held before the first and after the last.
     Table(Vec<[f64; 2]>),
     /// The FMU input in slot `slot` of the system's inputs.
     Input(usize),
 }
 
+/// A law with its cut-off: what a drive or a load evaluates at each time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeLaw {
+    /// The function of time.
     pub law: Law,
     /// The law is zero from this time on.
     pub until: Option<f64>,

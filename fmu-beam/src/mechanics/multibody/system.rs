@@ -115,14 +115,21 @@ pub struct BeamGroup {
     pub mid: (usize, PointMap),
 }
 
+/// The assembled planar system: its bodies stacked in q, the frames that joints and loads act
+/// on, the joints with their constraint rows, the loads, and the scene's beams.
 #[derive(Debug, Clone)]
 pub struct System {
+    /// The bodies (beam substructures and rigid bodies), in the order of their coordinates in q.
     pub bodies: Vec<Body>,
     /// Index of each body's first coordinate in q.
     pub offsets: Vec<usize>,
+    /// The frames that joints and loads act on: fixed in the world or material points of bodies.
     pub frames: Vec<Frame>,
+    /// The joints, each with its first constraint row in g(q).
     pub joints: Vec<Joint>,
+    /// The point loads.
     pub loads: Vec<Load>,
+    /// One group per scene beam, in scene order: its bodies (substructures) and section.
     pub beams: Vec<BeamGroup>,
     /// The gravity field, `None` when the effect is off (its terms are not evaluated).
     pub gravity: Option<Vector2<f64>>,
@@ -336,7 +343,6 @@ impl System {
         out
     }
 
-    /// Index of the scene joint `name` in `joints`.
     /// The body a frame lies on (`None` for the world).
     pub fn frame_body(&self, frame: usize) -> Option<usize> {
         match &self.frames[frame] {
@@ -345,6 +351,7 @@ impl System {
         }
     }
 
+    /// Index of the scene joint `name` in `joints`.
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
     }

@@ -9,9 +9,12 @@ use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix3, Vector3, 
 /// Coordinates of the frame: R (3) and p (4).
 pub const FRAME: usize = 7;
 
+/// A body of the spatial system, with coordinates z = [R, p, q_f] (q_f empty for a rigid one).
 #[derive(Debug, Clone)]
 pub enum Body3 {
+    /// A floating frame of a flexible beam: a whole beam or one of its substructures.
     Beam(Box<SpatialBeam>),
+    /// A rigid body (or the rigid equivalent of a beam).
     Rigid(RigidBody3),
 }
 
@@ -23,6 +26,7 @@ pub fn frame_of(z: &DVectorView<f64>) -> (Vector3<f64>, Vector4<f64>, Matrix3<f6
 }
 
 impl Body3 {
+    /// The body's name (a substructure's is `<beam>.<i>`).
     pub fn name(&self) -> &str {
         match self {
             Body3::Beam(b) => &b.name,
@@ -43,6 +47,7 @@ impl Body3 {
         FRAME + self.nflex()
     }
 
+    /// A rigid body of zero mass: its coordinates are algebraic (no inertia acts on them).
     pub fn is_massless(&self) -> bool {
         matches!(self, Body3::Rigid(r) if r.mass == 0.0)
     }
@@ -57,6 +62,8 @@ impl Body3 {
         }
     }
 
+    /// The body's size (m): a beam's length, a rigid body's largest distance from its frame
+    /// to a named frame; the system's length scale is the largest.
     pub fn length_scale(&self) -> f64 {
         match self {
             Body3::Beam(b) => b.length,

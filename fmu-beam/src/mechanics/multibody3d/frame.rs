@@ -6,14 +6,22 @@ use super::quaternion::{left_jacobian, rotation_derivatives};
 use crate::mechanics::beam::spatial_beam::{skew, SpatialPointMap};
 use nalgebra::{DMatrix, DVectorView, Matrix3, Rotation3, Vector3};
 
+/// A frame that joints and loads act on: its pose is fixed, or follows a point of a body.
 #[derive(Debug, Clone)]
 pub enum Frame3 {
+    /// Fixed in the world.
     World {
+        /// Position in the world (m).
         position: Vector3<f64>,
+        /// Rotation (frame → world).
         rotation: Matrix3<f64>,
     },
+    /// Attached to a material point of a body.
     OnBody {
+        /// Index of the body in the system's bodies.
         body: usize,
+        /// The material point: its position in the body frame and, for a beam, its
+        /// displacement and section rotation per deformation coordinate.
         map: SpatialPointMap,
         /// Rotation of the frame relative to the material section (frame → section).
         rotation: Matrix3<f64>,

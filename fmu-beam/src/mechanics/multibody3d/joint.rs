@@ -16,11 +16,16 @@ use crate::scene::DriveKind;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
 
+/// The kinds of spatial joint (their rows are in the module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum JointKind3 {
+    /// No relative motion (6 rows).
     Weld,
+    /// Rotation about frame 0's z axis (5 rows).
     Revolute,
+    /// Translation along frame 0's x axis (5 rows).
     Prismatic,
+    /// Rotation about a common point (3 rows).
     Spherical,
 }
 

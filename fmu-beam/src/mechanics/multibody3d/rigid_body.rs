@@ -2,8 +2,10 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
+/// A rigid body of the spatial system, its properties in its own frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigidBody3 {
+    /// Name of the scene body, or of the beam it is the rigid equivalent of.
     pub name: String,
     /// Mass (kg); zero makes the body's coordinates algebraic.
     pub mass: f64,

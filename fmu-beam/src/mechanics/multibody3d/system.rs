@@ -36,10 +36,16 @@ pub type FrameColumn = (usize, Vector3<f64>, Vector3<f64>);
 /// A world force and torque on a frame, scaled by an optional time law (1 without one).
 #[derive(Debug, Clone)]
 pub struct Load3 {
+    /// The scene load's name; for an input load, one unit load per component, `<load>.fx` …
+    /// `<load>.tz`.
     pub name: String,
+    /// Index of the frame it acts on in the system's frames.
     pub frame: usize,
+    /// Force, world axes (N).
     pub force: Vector3<f64>,
+    /// Torque, world axes (N·m).
     pub torque: Vector3<f64>,
+    /// The factor on force and torque: the scene's `scale`, or an input law (an input load).
     pub law: Option<TimeLaw>,
 }
 
@@ -51,16 +57,26 @@ pub struct BeamGroup3 {
     pub length: f64,
 }
 
+/// The assembled spatial system: bodies stacked in q (z = [R, p, q_f] each), frames, joints
+/// and loads; the quaternions' norm rows come before the joints' rows in g(q).
 #[derive(Debug, Clone)]
 pub struct System3 {
+    /// The bodies (beam substructures and rigid bodies), in the order of their coordinates in q.
     pub bodies: Vec<Body3>,
     /// Index of each body's first coordinate in q.
     pub offsets: Vec<usize>,
+    /// The frames that joints and loads act on: fixed in the world or on bodies.
     pub frames: Vec<Frame3>,
+    /// The joints, each with its first row among the joint rows.
     pub joints: Vec<Joint3>,
+    /// The point loads.
     pub loads: Vec<Load3>,
+    /// One group per beam, in the order added: its bodies (substructures) and length.
     pub beams: Vec<BeamGroup3>,
+    /// The gravity field (m/s², world axes), `None` when the effect is off (its terms are not
+    /// evaluated).
     pub gravity: Option<Vector3<f64>>,
+    /// Current values of the FMU inputs, by input slot.
     pub inputs: Vec<InputValue>,
     /// Coordinates of the placement (before assembly).
     initial: Vec<f64>,
@@ -178,6 +194,7 @@ impl System3 {
         self.add_frame(Frame3::on_body(body, map, Matrix3::identity()))
     }
 
+    /// Adds a frame; returns its index in `frames`.
     pub fn add_frame(&mut self, f: Frame3) -> usize {
         self.frames.push(f);
         self.frames.len() - 1
@@ -238,6 +255,7 @@ impl System3 {
         self.joints.len() - 1
     }
 
+    /// Adds a point load.
     pub fn add_load(&mut self, load: Load3) {
         self.loads.push(load);
     }

@@ -5,7 +5,8 @@
 use super::*;
 
 impl PlanarBeam {
-    /// The full model (every term on, no truncation).
+    /// The full model: the terms of [`BeamOptions::default`] (all but geometric stiffening),
+    /// no truncation.
     pub fn new(
         name: &str,
         length: f64,
@@ -31,6 +32,8 @@ impl PlanarBeam {
         )
     }
 
+    /// The beam computing the terms of `options` (on `options.modes` modes when set), of
+    /// density `rho` (kg/m^3) and Young's modulus `e` (Pa).
     #[allow(clippy::too_many_arguments)]
     pub fn with_options(
         name: &str,

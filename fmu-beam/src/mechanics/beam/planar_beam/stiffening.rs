@@ -4,6 +4,8 @@
 use super::*;
 
 impl PlanarBeam {
+    /// Switches geometric stiffening (the nonlinear axial strain) on or off; `options` keeps
+    /// the value the beam was built with.
     pub fn set_geometric_stiffening(&mut self, on: bool) {
         self.geometric_stiffening = on;
     }
