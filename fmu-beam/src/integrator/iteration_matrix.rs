@@ -18,7 +18,7 @@ use nalgebra::{DMatrix, DVector, Dyn, LU};
 /// How the iteration matrix is factorized.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LinearSolver {
-    /// Dense or sparse, by the system's size ([`prefers_sparse`]).
+    /// Dense or sparse, by the system's size (`prefers_sparse`).
     #[default]
     Auto,
     /// nalgebra's dense LU with partial pivoting, at every size.

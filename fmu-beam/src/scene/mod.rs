@@ -2,7 +2,7 @@
 //!
 //! A scene names its beams, the joints that hold them, the solver settings and the default
 //! experiment. Unknown keys are refused by serde (`deny_unknown_fields`); every value rule is
-//! checked in [`validate`], whose errors name the field and the rule.
+//! checked in `validate`, whose errors name the field and the rule.
 //!
 //! Over 600 lines on purpose: the format's spec structs, whose doc comments are the generated scene
 //! reference, read in one place.

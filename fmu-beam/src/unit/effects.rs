@@ -7,6 +7,9 @@
 //! of [`Decision`]s with the reason for each and its estimated share of the cost of a step
 //! (what `fmu-harness explain` prints and the FMU carries in `documentation/`). A term that is
 //! off is not evaluated: the beam's [`BeamOptions`] switch its code path off.
+//!
+//! Over 600 lines: `auto`'s decisions, each with the reason it gives the user, read as one
+//! policy (its cost model and its text are `effects/cost.rs` and `effects/explain.rs`).
 
 use crate::mechanics::beam::planar_beam::BeamOptions;
 use crate::mechanics::beam::section::Section;
@@ -194,7 +197,7 @@ fn non_rotating(scene: &Scene) -> BTreeSet<String> {
 }
 
 /// Resolves the effects of a validated scene. A 3D scene whose motion is planar resolves as
-/// its planar reduction (and says so first); any other 3D scene as [`spatial`].
+/// its planar reduction (and says so first); any other 3D scene as `spatial`.
 pub fn resolve(scene: &Scene) -> Resolution {
     if scene.is_3d() {
         return match scene.planar_reduction() {

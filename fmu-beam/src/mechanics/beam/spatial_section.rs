@@ -58,7 +58,7 @@ impl SpatialSection {
     }
 
     /// Solid rectangle, height a (along y) × width b (along z); J_t by the series of
-    /// [`torsion_constant_rectangle`].
+    /// `torsion_constant_rectangle`.
     pub fn rectangle(a: f64, b: f64) -> SpatialSection {
         SpatialSection::given(
             a * b,

@@ -152,7 +152,7 @@ pub trait Equations {
     fn joints_of_rows(&self, rows: &[usize]) -> Vec<String>;
     /// Power of drives and loads (W).
     fn power(&self, q: &DVector<f64>, v: &DVector<f64>, lambda: &DVector<f64>, t: f64) -> f64;
-    /// How the unknowns turn with the whole system ([`Turning`]); None where no such
+    /// How the unknowns turn with the whole system (`Turning`); None where no such
     /// symmetry is used.
     fn turning(&self) -> Option<Turning> {
         None

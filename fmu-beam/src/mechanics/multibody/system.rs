@@ -135,7 +135,7 @@ pub struct System {
     pub gravity: Option<Vector2<f64>>,
     /// The resolved effects the system was built with.
     pub effects: Effects,
-    /// Current values of the FMU inputs (slot order of [`input_slots`]).
+    /// Current values of the FMU inputs (slot order of `input_slots`).
     pub inputs: Vec<InputValue>,
     n: usize,
     m: usize,

@@ -183,7 +183,7 @@ impl Body3 {
     /// K_t = ∂r/∂z and C_t = ∂r/∂ż by forward differences (step `eps` max(|x|, 1)) into
     /// n × n views. The residual depends neither on R nor on Ṙ (their columns are zero); a
     /// beam's products are computed once and a column that moves q_f or q̇_f updates them by
-    /// one matrix column ([`BeamProducts`]).
+    /// one matrix column (`BeamProducts`).
     pub fn tangents(
         &self,
         z: DVectorView<f64>,

@@ -234,7 +234,7 @@ impl System3 {
         self.add_frame(Frame3::on_body(body, map, rot))
     }
 
-    /// Adds a joint between frames f0 and f1 (axes of f0, see [`super::joint`]).
+    /// Adds a joint between frames f0 and f1 (axes of f0, see `multibody3d::joint`).
     pub fn add_joint(
         &mut self,
         name: &str,
@@ -377,7 +377,7 @@ impl System3 {
     }
 
     /// ∂(joint coordinate)/∂q over the joint's columns by central differences: the reference
-    /// of the closed form [`System3::coordinate_gradient`] in the tests.
+    /// of the closed form `System3::coordinate_gradient` in the tests.
     pub fn coordinate_gradient_differences(&self, j: usize, q: &DVector<f64>) -> Vec<(usize, f64)> {
         let jt = &self.joints[j];
         let mut qq = q.clone();
@@ -705,7 +705,7 @@ impl Equations for System3 {
     }
 
     /// Norm rows 2pᵀ; joint rows in closed form, each column the rows' derivative along the
-    /// pose derivatives of one coordinate ([`Joint3::rows_acceleration`] at zero rates).
+    /// pose derivatives of one coordinate (`Joint3::rows_acceleration` at zero rates).
     fn jacobian_rows(&self, q: &DVector<f64>, _t: f64, gm: &mut JacobianRows) {
         gm.fill_zero();
         for (i, &o) in self.offsets.iter().enumerate() {

@@ -74,6 +74,8 @@ pub struct Snapshot {
     model: Option<ModelState>,
 }
 
+/// One FMU instance, safe: a scene with its variable table, the values set on it, and the
+/// model built from them at initialization (system, stepper, state). The FMI layer calls it.
 #[derive(Debug, Clone)]
 pub struct Engine {
     scene: Scene,
@@ -99,6 +101,8 @@ pub struct Engine {
 }
 
 impl Engine {
+    /// The instance of a validated scene, its parameters at their start values, not yet
+    /// initialized (the model is built at exit of initialization mode).
     pub fn new(scene: Scene) -> Engine {
         let effects = crate::unit::effects::resolve(&scene).effects;
         let table = VariableTable::build_with(&scene, &effects);
@@ -123,10 +127,12 @@ impl Engine {
         }
     }
 
+    /// The scene as packaged (parameter values set since are not written into it).
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
+    /// The variable table: value references, names, causalities, bindings.
     pub fn variables(&self) -> &VariableTable {
         &self.table
     }
@@ -141,26 +147,34 @@ impl Engine {
         *self = Engine::new(self.scene.clone());
     }
 
+    /// fmi2SetReal of one variable: a parameter (refused after initialization when fixed), an
+    /// input, or an input's derivative; a non-finite value is refused and changes nothing.
     pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), EngineError> {
         self.set(vr, VarType::Real, value)
     }
 
+    /// fmi2SetInteger of one variable (as [`Engine::set_real`]).
     pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), EngineError> {
         self.set(vr, VarType::Integer, value as f64)
     }
 
+    /// fmi2SetBoolean of one variable (as [`Engine::set_real`]).
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), EngineError> {
         self.set(vr, VarType::Boolean, if value { 1.0 } else { 0.0 })
     }
 
+    /// fmi2GetReal of one variable: a parameter or input as set, an output at the current
+    /// communication point (building the model first where needed).
     pub fn get_real(&mut self, vr: u32) -> Result<f64, EngineError> {
         self.get(vr, VarType::Real)
     }
 
+    /// fmi2GetInteger of one variable (the solver's counters).
     pub fn get_integer(&mut self, vr: u32) -> Result<i32, EngineError> {
         Ok(self.get(vr, VarType::Integer)? as i32)
     }
 
+    /// fmi2GetBoolean of one variable.
     pub fn get_boolean(&mut self, vr: u32) -> Result<bool, EngineError> {
         Ok(self.get(vr, VarType::Boolean)? != 0.0)
     }
@@ -391,7 +405,7 @@ impl Engine {
     }
 
     /// fmi2GetDirectionalDerivative: Σ_j ∂y_i/∂u_j dv_j for outputs y_i and inputs u_j, exact, at
-    /// the current communication point ([`crate::unit::interface`]).
+    /// the current communication point (`unit::interface`).
     pub fn directional_derivative(
         &mut self,
         unknowns: &[u32],

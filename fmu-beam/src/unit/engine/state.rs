@@ -10,6 +10,7 @@ const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
 const STATE_VERSION: u32 = 5;
 
 impl Engine {
+    /// fmi2GetFMUstate: a copy of everything that changes while the instance runs.
     pub fn snapshot(&self) -> Snapshot {
         Snapshot {
             initialized: self.initialized,
@@ -20,6 +21,8 @@ impl Engine {
         }
     }
 
+    /// fmi2SetFMUstate: the instance as it was at `s` (the model rebuilt from its parameter
+    /// values, the integration state put back); a state of another model is refused.
     pub fn restore(&mut self, s: &Snapshot) -> Result<(), EngineError> {
         self.values = s.values.clone();
         self.input_ders = s.input_ders.clone();
@@ -61,6 +64,8 @@ impl Engine {
         })
     }
 
+    /// fmi2SerializeFMUstate: `s` as bytes, headed by the format's magic, version and the
+    /// scene's fingerprint.
     pub fn serialize(&self, s: &Snapshot) -> Vec<u8> {
         let mut w = Vec::new();
         w.extend_from_slice(STATE_MAGIC);
@@ -92,6 +97,8 @@ impl Engine {
         w
     }
 
+    /// fmi2DeSerializeFMUstate: the snapshot of [`Engine::serialize`]'s bytes, every length
+    /// checked; bytes of another version or scene are refused.
     pub fn deserialize(&self, bytes: &[u8]) -> Result<Snapshot, EngineError> {
         let mut r = Reader::new(bytes);
         let bad = |m: &str| EngineError::BadState {

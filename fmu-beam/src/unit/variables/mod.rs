@@ -6,14 +6,19 @@ mod build;
 use crate::scene::Scene;
 use crate::unit::effects::Effects;
 
+/// The FMI type of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VarType {
+    /// fmi2Real: every physical quantity.
     Real,
+    /// fmi2Integer: the solver's counters.
     Integer,
+    /// fmi2Boolean: switches such as `solver.adaptive`.
     Boolean,
 }
 
 impl VarType {
+    /// The element name in modelDescription.xml (`Real`, `Integer`, `Boolean`).
     pub fn as_str(self) -> &'static str {
         match self {
             VarType::Real => "Real",
@@ -23,15 +28,21 @@ impl VarType {
     }
 }
 
+/// The FMI causality of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Causality {
+    /// Set by the user before (fixed) or between (tunable) steps.
     Parameter,
+    /// Computed from parameters.
     CalculatedParameter,
+    /// Set by the master at communication points.
     Input,
+    /// Read by the master at communication points.
     Output,
 }
 
 impl Causality {
+    /// The attribute value in modelDescription.xml (`parameter`, `input`, ...).
     pub fn as_str(self) -> &'static str {
         match self {
             Causality::Parameter => "parameter",
@@ -61,13 +72,17 @@ impl Variability {
     }
 }
 
+/// The FMI `initial` attribute of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Initial {
+    /// Its start value is the value (parameters).
     Exact,
+    /// Computed by the unit (outputs, calculated parameters).
     Calculated,
 }
 
 impl Initial {
+    /// The attribute value in modelDescription.xml (`exact`, `calculated`).
     pub fn as_str(self) -> &'static str {
         match self {
             Initial::Exact => "exact",
@@ -180,45 +195,65 @@ pub enum OutputKind {
     NextEventTime,
 }
 
+/// What a variable reads or writes in the engine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Binding {
+    /// A parameter, written into the scene (or the running solver) as the target says.
     Parameter(ParamTarget),
+    /// An output, computed from the state at the communication point.
     Output(OutputKind),
     /// FMU input in this slot of `multibody::system::input_slots`.
     Input(usize),
     /// The first or second time derivative (`order` 1 or 2) of the motion input in `slot`, as
     /// an input of its own: the same value fmi2SetRealInputDerivatives sets.
     InputDerivative {
+        /// The motion input's slot.
         slot: usize,
+        /// 1 (rate) or 2 (acceleration).
         order: u8,
     },
 }
 
+/// One variable of the unit, as modelDescription.xml declares it and the engine serves it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable {
+    /// Structured name (`crank.tip.y`, `solver.tolerance`).
     pub name: String,
+    /// Value reference: the variable's index in the table.
     pub vr: u32,
+    /// FMI type.
     pub ty: VarType,
+    /// FMI causality.
     pub causality: Causality,
+    /// FMI variability (fixed, tunable, discrete, continuous).
     pub variability: Variability,
+    /// FMI `initial`, where the standard asks for one.
     pub initial: Option<Initial>,
+    /// A name of [`UNITS`], or none (dimensionless, counters, Booleans).
     pub unit: Option<&'static str>,
+    /// What it is, for the XML and the FMU's documentation.
     pub description: String,
     /// Start value of parameters (Booleans as 0/1).
     pub start: Option<f64>,
+    /// What it reads or writes in the engine.
     pub binding: Binding,
     /// Of an output: the inputs (value references) it depends on directly, for ModelStructure
-    /// ([`crate::unit::interface::dependencies`]); empty otherwise.
+    /// (`unit::interface::dependencies`); empty otherwise.
     pub dependencies: Vec<u32>,
 }
 
 /// A unit in SI base-unit exponents, for UnitDefinitions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct UnitDef {
+    /// The unit's name as variables use it (`m/s2`, `N.m`).
     pub name: &'static str,
+    /// Exponent of kilogram.
     pub kg: i32,
+    /// Exponent of metre.
     pub m: i32,
+    /// Exponent of second.
     pub s: i32,
+    /// Exponent of radian.
     pub rad: i32,
 }
 
@@ -254,6 +289,7 @@ pub const UNITS: &[UnitDef] = &[
 /// All variables of a scene, in value-reference order (vr = index; unique over all types).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VariableTable {
+    /// The variables, indexed by value reference.
     pub variables: Vec<Variable>,
 }
 
@@ -275,10 +311,12 @@ impl VariableTable {
         VariableTable { variables: vars }
     }
 
+    /// The variable of value reference `vr`.
     pub fn get(&self, vr: u32) -> Option<&Variable> {
         self.variables.get(vr as usize)
     }
 
+    /// The variable named `name`.
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }

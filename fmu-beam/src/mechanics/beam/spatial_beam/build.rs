@@ -11,7 +11,7 @@ impl SpatialBeam {
 
     /// One floating frame of a beam: the whole beam, or one of its substructures, named
     /// `name`, of length `length`, with `props.elements` elements (as
-    /// [`super::planar_beam::PlanarBeam::part_of`]; substructures are welded flange b to
+    /// `PlanarBeam::part_of`; substructures are welded flange b to
     /// flange a of the next by the multibody layer, paper §3.4).
     pub fn part_of(props: &SpatialBeamProps, name: &str, length: f64) -> SpatialBeam {
         let props = SpatialBeamProps {
