@@ -1,9 +1,11 @@
 //! fmu-beam: a flexible-multibody core (floating-frame Euler–Bernoulli beams, joints,
 //! generalized-α) and its FMI 2.0 co-simulation ABI.
 //!
-//! Five layers, each importing only from those below it (`tests/layers.rs` checks it):
-//! 1. [`scene`]: the file format (parsing, validation, the rule table); `error` beside it;
-//! 2. [`mechanics`]: beam sections and elements, planar and spatial systems, joints, equations;
+//! Five layers on a floor, each importing only from those below it (`tests/layers.rs` checks
+//! it):
+//! 0. the elements (`mechanics/beam/`): sections and finite elements, which import nothing;
+//! 1. [`scene`]: the file format (parsing, validation, the rule table); `error` above it;
+//! 2. [`mechanics`]: planar and spatial systems, joints, equations, built from the scene;
 //! 3. [`integrator`]: generalized-α, Newton, the iteration matrix, the state codec;
 //! 4. `unit`: one FMU instance, safe ([`Engine`]), its variables, interface, effects policy;
 //! 5. `fmi2`: the C ABI, the only unsafe code.
@@ -12,6 +14,7 @@
 //! table, the effects it resolves), and, for those who assemble systems without a scene (the
 //! benchmarks), the curated [`mechanics`] and [`integrator`] modules. Everything else is
 //! private to the crate.
+
 #![warn(missing_docs)]
 
 mod error;
