@@ -19,7 +19,7 @@ use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
+use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Point, Turning};
 use nalgebra::DVector;
 
 mod error_control;

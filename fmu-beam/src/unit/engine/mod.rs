@@ -493,9 +493,9 @@ impl Engine {
                     };
                 }
             }
-            let state = integrator::initial_state(&system, &scene, self.start_time, &settings)?;
+            let state = integrator::initial_state(&system, self.start_time, &settings)?;
             let (joint_index, body_index) = match &system {
-                Mechanics::Planar(sys, _) => (
+                Mechanics::Planar(sys) => (
                     scene
                         .joints
                         .iter()
