@@ -155,7 +155,8 @@ fn package_cmd(
     .map_err(stdout_err)
 }
 
-/// `simulate`: runs the FMU and writes its CSV to `csv` or `out`.
+/// `simulate`: runs the FMU and streams its CSV, row by row, to `csv` or `out`. A file is
+/// written as a temporary sibling (removed on an error or a signal) renamed at the end.
 fn simulate_cmd(
     fmu: &Path,
     stop: Option<f64>,
@@ -169,12 +170,35 @@ fn simulate_cmd(
         step,
         outputs,
     };
-    let text = simulate::simulate(fmu, &options)?.csv();
     match csv {
         Some(path) => {
-            std::fs::write(path, text).map_err(|e| HarnessError::io(path, "writing the CSV", e))
+            let name = path
+                .file_name()
+                .ok_or_else(|| HarnessError::BadOutput {
+                    path: path.to_path_buf(),
+                })?
+                .to_string_lossy()
+                .into_owned();
+            let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+            let (scratch, file) = crate::scratch::Scratch::file(&tmp)
+                .map_err(|e| HarnessError::io(&tmp, "creating the CSV", e))?;
+            let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(file));
+            simulate::simulate_into(fmu, &options, &mut writer)?;
+            writer
+                .into_inner()
+                .into_inner()
+                .map_err(|e| e.into_error())
+                .and_then(|f| f.sync_all())
+                .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+            scratch
+                .persist(path)
+                .map_err(|e| HarnessError::io(path, "moving the CSV in place", e))
         }
-        None => out.write_all(text.as_bytes()).map_err(stdout_err),
+        None => {
+            let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(out));
+            simulate::simulate_into(fmu, &options, &mut writer)?;
+            writer.into_inner().flush().map_err(stdout_err)
+        }
     }
 }
 

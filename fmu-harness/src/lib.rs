@@ -21,6 +21,7 @@ pub mod package;
 pub mod platform;
 pub mod reference;
 pub mod schema;
+pub mod scratch;
 pub mod simulate;
 pub mod slave;
 pub mod template;
