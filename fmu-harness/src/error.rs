@@ -73,8 +73,47 @@ pub enum HarnessError {
     Animate(#[from] crate::animate::AnimateError),
     #[error("{origin}: {message}")]
     Input { origin: String, message: String },
+    #[error(
+        "{}: {kind}; an engine library must be a regular file",
+        .path.display()
+    )]
+    LibraryNotRegular { path: PathBuf, kind: &'static str },
+    #[error(
+        "{}: {bytes} bytes or more; an engine library may have at most {limit}",
+        .path.display()
+    )]
+    LibraryTooLarge {
+        path: PathBuf,
+        bytes: u64,
+        limit: u64,
+    },
+    #[error("{}: its symbol table cannot be read: {reason}", .path.display())]
+    LibrarySymbols { path: PathBuf, reason: String },
+    #[error(
+        "{}: {}",
+        .path.display(),
+        missing_functions_message(*.count, *.of, .missing)
+    )]
+    MissingFunctions {
+        path: PathBuf,
+        count: usize,
+        of: usize,
+        missing: Vec<&'static str>,
+    },
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
     BadOutput { path: PathBuf },
+}
+
+/// Which FMI 2.0 functions a `--binary` does not export.
+fn missing_functions_message(count: usize, of: usize, missing: &[&str]) -> String {
+    if count == of {
+        format!("exports none of the {of} FMI 2.0 co-simulation functions: not an FMU binary")
+    } else {
+        format!(
+            "does not export {count} of the {of} FMI 2.0 co-simulation functions: {}",
+            missing.join(", ")
+        )
+    }
 }
 
 /// Why a `--binary` cannot go under its platform's folder.

@@ -10,6 +10,7 @@ pub mod animate;
 pub mod archive;
 pub mod cli;
 pub mod cosim;
+pub mod engine_library;
 pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi2_binding;
