@@ -202,7 +202,7 @@ pub fn simulate_into(
         return Err(SimulateError::BadExperiment { start, stop, step });
     }
     let steps = ((stop - start) / step).ceil();
-    if !(steps <= MAX_COMMUNICATION_STEPS) {
+    if steps.is_nan() || steps > MAX_COMMUNICATION_STEPS {
         return Err(SimulateError::TooManySteps {
             start,
             stop,

@@ -468,10 +468,38 @@ fn an_absurd_number_of_communication_steps_is_refused_at_once() {
     assert!(run.elapsed < Duration::from_secs(10), "{:?}", run.elapsed);
     let run = simulate(&dir, &c1, &["--step", "1e-12"], QUICK);
     refused(&run, &["communication steps", "at most 1e8"]);
-    // The bound leaves an ordinary run alone.
+    // The bound leaves an ordinary run alone, and the streamed CSV is Results::csv's bytes.
     let run = simulate(&dir, &c1, &["--stop", "0.01"], QUICK);
     assert!(run.status.success(), "{}", run.stderr);
     assert!(run.left.is_empty(), "{:?}", run.left);
+    let options = fmu_harness::simulate::Options {
+        stop_time: Some(0.01),
+        ..Default::default()
+    };
+    let kept = fmu_harness::simulate::simulate(&c1, &options)
+        .unwrap()
+        .csv();
+    assert!(kept.lines().count() > 2);
+    assert!(std::fs::read_to_string(dir.join("out.csv")).unwrap() == kept);
+
+    // cosim: a fixed step refused by the system file's check, before any unit is loaded.
+    let system = dir.join("system.toml");
+    std::fs::write(
+        &system,
+        format!(
+            "start_time = 0.0\nstop_time = 1.0\nstep = {{ size = 1e-300 }}\n\n\
+             [[unit]]\nname = \"c1\"\nfmu = \"{}\"\n",
+            c1.display()
+        ),
+    )
+    .unwrap();
+    let r = harness(&["cosim".as_ref(), system.as_os_str()]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success());
+    assert!(
+        stderr.contains("step.size") && stderr.contains("at most 1e8"),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -116,11 +116,26 @@ pub fn packaged_scene(path: &Path) -> Result<Option<Scene>, HarnessError> {
     let Ok(mut entry) = zip.by_name("resources/scene.toml") else {
         return Ok(None);
     };
+    let origin = format!("{}!resources/scene.toml", path.display());
+    let refuse = |message: String| HarnessError::Input {
+        origin: origin.clone(),
+        message,
+    };
+    // The FMU is untrusted, as in `Slave::load`: no link, and no more than it may expand to.
+    if entry.is_symlink() {
+        return Err(refuse("a symbolic link: the master refuses it".into()));
+    }
+    let limit = crate::slave::MAX_EXTRACTED_BYTES;
     let mut text = String::new();
-    entry
+    (&mut entry)
+        .take(limit + 1)
         .read_to_string(&mut text)
         .map_err(|e| HarnessError::io(path, "reading resources/scene.toml", e))?;
-    let origin = format!("{}!resources/scene.toml", path.display());
+    if text.len() as u64 > limit {
+        return Err(refuse(format!(
+            "more than {limit} bytes: the master extracts at most that"
+        )));
+    }
     Ok(Some(Scene::from_toml_str(&text, &origin)?))
 }
 

@@ -347,6 +347,18 @@ impl System {
             }
         };
         positive("step.size", self.step.size)?;
+        let steps = ((self.stop_time - self.start_time) / self.step.size).ceil();
+        let limit = crate::simulate::MAX_COMMUNICATION_STEPS;
+        if self.step.variable.is_none() && (steps.is_nan() || steps > limit) {
+            return Err(bad(
+                "step.size",
+                format!(
+                    "= {:e}: {steps:.3e} communication steps from start_time to stop_time; \
+                     the master takes at most {limit:e}",
+                    self.step.size
+                ),
+            ));
+        }
         if let Some(v) = &self.step.variable {
             positive("step.variable.min", v.min)?;
             positive("step.variable.max", v.max)?;

@@ -3,7 +3,7 @@
 //! the packager writes is [`crate::model_description`]'s).
 
 use super::extract::shown;
-use super::SlaveError;
+use super::{FmuRefused, SlaveError};
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
 use std::path::Path;
@@ -143,12 +143,12 @@ impl ModelDescription {
         loop {
             let event = reader.read_event().map_err(|e| {
                 let (line, column) = line_column(xml, reader.error_position() as usize);
-                SlaveError::XmlSyntax {
+                SlaveError::from(FmuRefused::XmlSyntax {
                     path: origin.to_path_buf(),
                     line,
                     column,
                     expected: expected(&e),
-                }
+                })
             })?;
             let (e, empty) = match &event {
                 Event::Start(e) => (e, false),
@@ -180,13 +180,13 @@ impl ModelDescription {
                     let id = attr("modelIdentifier")?
                         .ok_or_else(|| fail("CoSimulation has no modelIdentifier".into()))?;
                     if let Some(reason) = identifier_problem(&id) {
-                        return Err(SlaveError::ModelIdentifier {
+                        return Err(SlaveError::from(FmuRefused::ModelIdentifier {
                             path: origin.to_path_buf(),
                             shown: shown(&id),
                             bytes: id.len(),
                             limit: MAX_MODEL_IDENTIFIER_BYTES,
                             reason,
-                        });
+                        }));
                     }
                     md.model_identifier = id;
                     md.can_get_and_set_fmu_state =
@@ -324,13 +324,13 @@ fn check_value_references(variables: &[Variable], origin: &Path) -> Result<(), S
                     _ => None,
                 };
                 if let Some(o) = other {
-                    return Err(SlaveError::DuplicateValueReference {
+                    return Err(SlaveError::from(FmuRefused::DuplicateValueReference {
                         path: origin.to_path_buf(),
                         vr: v.value_reference,
                         kind: key.0,
                         first: shown(&variables[o].name),
                         second: shown(&v.name),
-                    });
+                    }));
                 }
             }
         }

@@ -7,7 +7,7 @@
 //! new (`create_new`: an entry given twice is refused) and only in folders this code made, so
 //! nothing it writes can follow a link.
 
-use super::SlaveError;
+use super::{FmuRefused, SlaveError};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -91,26 +91,30 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
         path: fmu.to_path_buf(),
         source,
     };
-    let unsafe_entry = |name: &str, reason: &'static str| SlaveError::UnsafeEntry {
-        path: fmu.to_path_buf(),
-        entry: shown(name),
-        reason,
+    let unsafe_entry = |name: &str, reason: &'static str| {
+        SlaveError::from(FmuRefused::UnsafeEntry {
+            path: fmu.to_path_buf(),
+            entry: shown(name),
+            reason,
+        })
     };
-    let too_large = |name: &str, bytes: u64, declared: bool| SlaveError::TooLarge {
-        path: fmu.to_path_buf(),
-        entry: shown(name),
-        bytes,
-        declared,
-        limit: MAX_EXTRACTED_BYTES,
+    let too_large = |name: &str, bytes: u64, declared: bool| {
+        SlaveError::from(FmuRefused::TooLarge {
+            path: fmu.to_path_buf(),
+            entry: shown(name),
+            bytes,
+            declared,
+            limit: MAX_EXTRACTED_BYTES,
+        })
     };
     let file = std::fs::File::open(fmu).map_err(io(fmu, "opening the FMU"))?;
     let mut archive = zip::ZipArchive::new(file).map_err(zip_err)?;
     if archive.len() > MAX_ENTRIES {
-        return Err(SlaveError::TooManyEntries {
+        return Err(SlaveError::from(FmuRefused::TooManyEntries {
             path: fmu.to_path_buf(),
             entries: archive.len(),
             limit: MAX_ENTRIES,
-        });
+        }));
     }
     // Every entry's name, kind and declared size first: nothing is written from an FMU that
     // would be refused for any of them.
@@ -156,11 +160,11 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
         let budget = MAX_EXTRACTED_BYTES - written;
         let copied =
             std::io::copy(&mut (&mut entry).take(budget + 1), &mut out).map_err(|source| {
-                SlaveError::Entry {
+                SlaveError::from(FmuRefused::Entry {
                     path: fmu.to_path_buf(),
                     entry: shown(entry.name()),
                     source,
-                }
+                })
             })?;
         written += copied;
         if copied > budget {
@@ -172,9 +176,11 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
 
 /// Where the model's binary must be: a regular file (not a link) inside `dir`.
 pub(super) fn binary_inside(dir: &Path, library: &Path) -> Result<(), SlaveError> {
-    let refuse = |reason: &'static str| SlaveError::Binary {
-        path: library.to_path_buf(),
-        reason,
+    let refuse = |reason: &'static str| {
+        SlaveError::from(FmuRefused::Binary {
+            path: library.to_path_buf(),
+            reason,
+        })
     };
     let meta = std::fs::symlink_metadata(library).map_err(|_| refuse("is not in the FMU"))?;
     if !meta.file_type().is_file() {

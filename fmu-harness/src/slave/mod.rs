@@ -35,6 +35,35 @@ pub enum SlaveError {
     },
     #[error("{}: modelDescription.xml: {message}", .path.display())]
     ModelDescription { path: PathBuf, message: String },
+    /// The FMU was refused as unsafe or absurd (boxed: [`FmuRefused`] carries the figures).
+    #[error(transparent)]
+    Refused(Box<FmuRefused>),
+    #[error(transparent)]
+    Load(#[from] fmi2_binding::LoadError),
+    #[error("{function} returned {status}{}", messages_suffix(.messages))]
+    Call {
+        function: &'static str,
+        status: Status,
+        messages: Vec<LogMessage>,
+    },
+    #[error("fmi2Instantiate returned NULL{}", messages_suffix(.messages))]
+    Instantiate { messages: Vec<LogMessage> },
+    #[error("{function}: the FMU does not export it")]
+    NotExported { function: &'static str },
+    #[error("{function}: the FMU state belongs to another instance, or is empty")]
+    ForeignState { function: &'static str },
+    #[error("{function}: the instance was not instantiated (call Slave::instantiate)")]
+    NotInstantiated { function: &'static str },
+    #[error("no variable named `{name}` in the model description")]
+    UnknownVariable { name: String },
+    #[error("{what} contains a NUL byte")]
+    Nul { what: &'static str },
+}
+
+/// Why the master refuses an FMU it was given (issue 35): an archive entry, a limit, the model
+/// description or the binary; each variant carries the names and figures its message gives.
+#[derive(Debug, Error)]
+pub enum FmuRefused {
     #[error(
         "{}: line {line}, column {column}: not well-formed XML: {expected}",
         .path.display()
@@ -106,26 +135,12 @@ pub enum SlaveError {
     },
     #[error("{}: the model's binary {reason}; the master loads only a regular file of the FMU", .path.display())]
     Binary { path: PathBuf, reason: &'static str },
-    #[error(transparent)]
-    Load(#[from] fmi2_binding::LoadError),
-    #[error("{function} returned {status}{}", messages_suffix(.messages))]
-    Call {
-        function: &'static str,
-        status: Status,
-        messages: Vec<LogMessage>,
-    },
-    #[error("fmi2Instantiate returned NULL{}", messages_suffix(.messages))]
-    Instantiate { messages: Vec<LogMessage> },
-    #[error("{function}: the FMU does not export it")]
-    NotExported { function: &'static str },
-    #[error("{function}: the FMU state belongs to another instance, or is empty")]
-    ForeignState { function: &'static str },
-    #[error("{function}: the instance was not instantiated (call Slave::instantiate)")]
-    NotInstantiated { function: &'static str },
-    #[error("no variable named `{name}` in the model description")]
-    UnknownVariable { name: String },
-    #[error("{what} contains a NUL byte")]
-    Nul { what: &'static str },
+}
+
+impl From<FmuRefused> for SlaveError {
+    fn from(r: FmuRefused) -> Self {
+        SlaveError::Refused(Box::new(r))
+    }
 }
 
 fn messages_suffix(messages: &[LogMessage]) -> String {
