@@ -1,15 +1,13 @@
 //! An engine library given to `fmu-harness package` (`--binary [PLATFORM=]PATH`), read with
-//! care (issue 35): it must be a regular file (the type is checked before opening, and again on
-//! the open file, opened non-blocking, so a FIFO or a device never blocks the packager), of at
-//! most [`MAX_LIBRARY_BYTES`] (the cap is kept while reading, not only from the size the file
-//! system reports), and it must export every FMI 2.0 co-simulation function
+//! care (issue 35): it must be a regular file of at most [`MAX_LIBRARY_BYTES`]
+//! ([`crate::input_file::read`]: the type checked before opening and on the open file, the cap
+//! kept while reading), and it must export every FMI 2.0 co-simulation function
 //! ([`FMI2_COSIMULATION_FUNCTIONS`]), read from its symbol table (ELF `.dynsym`, PE export
 //! table) with the `object` crate: nothing of the library is loaded or run to package it.
 
 use crate::error::HarnessError;
 use crate::platform::Platform;
 use object::{Object, ObjectSymbol};
-use std::io::Read;
 use std::path::Path;
 
 /// Bytes of one engine library: 256 MiB (the engine is a few MB).
@@ -54,71 +52,13 @@ pub const FMI2_COSIMULATION_FUNCTIONS: [&str; 34] = [
     "fmi2GetStringStatus",
 ];
 
-/// What a file that is not a regular file is, for messages.
-fn file_kind(t: std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a folder"
-    } else {
-        "not a regular file"
-    }
-}
-
 /// The bytes of the library at `path`, or why it is refused (not a regular file, too large).
 pub fn read(path: &Path) -> Result<Vec<u8>, HarnessError> {
-    let not_regular = |t: std::fs::FileType| HarnessError::LibraryNotRegular {
-        path: path.to_path_buf(),
-        kind: file_kind(t),
-    };
-    let too_large = |bytes: u64| HarnessError::LibraryTooLarge {
-        path: path.to_path_buf(),
-        bytes,
-        limit: MAX_LIBRARY_BYTES,
-    };
-    let io = |e| HarnessError::io(path, "reading the engine library", e);
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    if meta.len() > MAX_LIBRARY_BYTES {
-        return Err(too_large(meta.len()));
-    }
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        // O_NONBLOCK: a FIFO put there since the check opens at once instead of waiting.
-        options.custom_flags(0o4000);
-    }
-    let file = options.open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len().min(MAX_LIBRARY_BYTES) as usize);
-    file.take(MAX_LIBRARY_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() as u64 > MAX_LIBRARY_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    Ok(crate::input_file::read(
+        path,
+        "an engine library",
+        MAX_LIBRARY_BYTES,
+    )?)
 }
 
 /// The FMI 2.0 co-simulation functions `bytes` (a library of `platform`) does not export, in

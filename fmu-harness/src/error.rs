@@ -73,20 +73,8 @@ pub enum HarnessError {
     Animate(#[from] crate::animate::AnimateError),
     #[error("{origin}: {message}")]
     Input { origin: String, message: String },
-    #[error(
-        "{}: {kind}; an engine library must be a regular file",
-        .path.display()
-    )]
-    LibraryNotRegular { path: PathBuf, kind: &'static str },
-    #[error(
-        "{}: {bytes} bytes or more; an engine library may have at most {limit}",
-        .path.display()
-    )]
-    LibraryTooLarge {
-        path: PathBuf,
-        bytes: u64,
-        limit: u64,
-    },
+    #[error(transparent)]
+    InputFile(#[from] crate::input_file::InputFileError),
     #[error("{}: its symbol table cannot be read: {reason}", .path.display())]
     LibrarySymbols { path: PathBuf, reason: String },
     #[error(

@@ -15,6 +15,7 @@ pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi2_binding;
 pub mod guid;
+pub mod input_file;
 pub mod log_categories;
 pub mod model_description;
 pub mod modes;

@@ -4,6 +4,7 @@
 
 use super::extract::shown;
 use super::{FmuRefused, SlaveError};
+use crate::input_file::line_column;
 use quick_xml::events::{BytesStart, Event};
 use std::collections::HashMap;
 use std::path::Path;
@@ -27,18 +28,6 @@ fn identifier_problem(id: &str) -> Option<&'static str> {
         }
         _ => None,
     }
-}
-
-/// Line and column (1-based, in characters) of byte `pos` of `text`.
-fn line_column(text: &str, pos: usize) -> (usize, usize) {
-    let mut pos = pos.min(text.len());
-    while !text.is_char_boundary(pos) {
-        pos -= 1;
-    }
-    let before = &text[..pos];
-    let line = before.matches('\n').count() + 1;
-    let start = before.rfind('\n').map_or(0, |i| i + 1);
-    (line, before[start..].chars().count() + 1)
 }
 
 /// What the XML parser expected, in words of our own: the parser's own messages quote the
