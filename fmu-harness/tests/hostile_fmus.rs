@@ -143,6 +143,31 @@ fn a_symbolic_link_entry_is_refused_and_never_followed() {
     );
     let run = simulate(&dir, &fmu, &[], QUICK);
     refused(&run, &["binaries/linux64/m.so", "symbolic link"]);
+
+    // cosim loads its units the same way.
+    let system = dir.join("system.toml");
+    std::fs::write(
+        &system,
+        format!(
+            "stop_time = 1.0\nstep = {{ size = 1e-3 }}\n\n[[unit]]\nname = \"a\"\nfmu = \"{}\"\n",
+            fmu.display()
+        ),
+    )
+    .unwrap();
+    let tmp = dir.join("tmp");
+    let r = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
+        .arg("cosim")
+        .arg(&system)
+        .env("TMPDIR", &tmp)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success());
+    assert!(
+        stderr.contains("unit `a`") && stderr.contains("symbolic link"),
+        "{stderr}"
+    );
+    assert!(leftovers(&tmp).is_empty());
 }
 
 #[test]
@@ -503,48 +528,74 @@ fn an_absurd_number_of_communication_steps_is_refused_at_once() {
 }
 
 #[test]
-fn sigterm_during_simulate_leaves_no_extraction_folder() {
+fn sigterm_or_sigint_during_a_run_leaves_no_extraction_folder() {
     let dir = scratch("hostile_sigterm");
     let c1 = c1_fmu(&dir);
+    let system = dir.join("system.toml");
+    std::fs::write(
+        &system,
+        format!(
+            "stop_time = 1e4\nstep = {{ size = 1e-3 }}\n\n[[unit]]\nname = \"c1\"\nfmu = \"{}\"\n",
+            c1.display()
+        ),
+    )
+    .unwrap();
     let tmp = dir.join("tmp");
     std::fs::create_dir_all(&tmp).unwrap();
     let csv = dir.join("long.csv");
-    let child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
-        .arg("simulate")
-        .arg(&c1)
-        .args(["--stop", "1e4", "-o"])
-        .arg(&csv)
-        .env("TMPDIR", &tmp)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let pid = child.id();
-    let start = Instant::now();
-    while leftovers(&tmp).is_empty() {
-        assert!(start.elapsed() < QUICK, "no extraction folder appeared");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    // Well into the run: the CSV is being written.
-    std::thread::sleep(Duration::from_millis(300));
-    let kill = Command::new("kill")
-        .args(["-TERM", &pid.to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let (status, _) = wait_bounded(child, QUICK, "simulate after SIGTERM");
-    assert!(!status.success());
-    assert_eq!(leftovers(&tmp), Vec::<PathBuf>::new());
-    let half_written: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
-        .collect();
-    assert!(half_written.is_empty(), "{half_written:?}");
-    assert!(!csv.exists());
-    #[cfg(unix)]
-    {
-        use std::os::unix::process::ExitStatusExt;
-        assert_eq!(status.signal(), Some(15), "{status:?}");
+    let half_written = || -> Vec<PathBuf> {
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.to_string_lossy().contains(".long.csv.tmp-"))
+            .collect()
+    };
+    for (command, run, signal, number) in [
+        ("simulate", &c1, "TERM", 15),
+        ("simulate", &c1, "INT", 2),
+        ("cosim", &system, "TERM", 15),
+    ] {
+        let child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
+            .arg(command)
+            .arg(run)
+            .args(if command == "simulate" {
+                &["--stop", "1e4"][..]
+            } else {
+                &[]
+            })
+            .arg("-o")
+            .arg(&csv)
+            .env("TMPDIR", &tmp)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        let start = Instant::now();
+        while leftovers(&tmp).is_empty() {
+            assert!(
+                start.elapsed() < QUICK,
+                "{command}: no extraction folder appeared"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        // Well into the run: the CSV is being written.
+        std::thread::sleep(Duration::from_millis(300));
+        assert_eq!(half_written().len(), 1, "{command}: no CSV being written");
+        let kill = Command::new("kill")
+            .args([&format!("-{signal}"), &pid.to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        let (status, _) = wait_bounded(child, QUICK, command);
+        assert!(!status.success());
+        assert_eq!(leftovers(&tmp), Vec::<PathBuf>::new(), "{command} {signal}");
+        assert_eq!(half_written(), Vec::<PathBuf>::new(), "{command} {signal}");
+        assert!(!csv.exists());
+        #[cfg(unix)]
+        {
+            use std::os::unix::process::ExitStatusExt;
+            assert_eq!(status.signal(), Some(number), "{command}: {status:?}");
+        }
     }
 }
