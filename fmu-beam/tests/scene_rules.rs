@@ -72,6 +72,21 @@ fn scene_text(all: &Value, case: &Value) -> String {
             *slot(&mut doc, path) = v.clone();
         }
     }
+    if let Some(Value::Table(repeat)) = case.get("repeat") {
+        for (path, length) in repeat {
+            let length = length.as_integer().unwrap() as usize;
+            let Value::Array(items) = slot(&mut doc, path) else {
+                panic!("repeat {path}: not an array");
+            };
+            while items.len() < length {
+                let mut item = items.last().unwrap().clone();
+                if let Some(Value::String(name)) = item.get_mut("name") {
+                    *name = format!("{name}_{}", items.len());
+                }
+                items.push(item);
+            }
+        }
+    }
     for beam in doc
         .get_mut("beam")
         .and_then(Value::as_array_mut)
