@@ -35,12 +35,16 @@ impl Scene {
     /// numbers, not an overflow).
     pub fn size(&self) -> Size {
         let three = self.is_3d();
-        // per frame: rigid coordinates, deformation coordinates per element, dense matrices
-        // per frame (mass, stiffness, damping, and in 3D the six inertia integrals)
+        // per frame: rigid coordinates, deformation coordinates per element, and the dense
+        // matrices of its deformation coordinates that the beam and the assembly hold (mass,
+        // stiffness, damping, inertia integrals, their blocks in the assembled matrices): 8
+        // planar, measured (C1 at 250 and 500 elements: 56 and 202 MB of peak resident memory
+        // of `fmu-harness simulate`, against 45 and 180 MB estimated); 14 in 3D, the planar
+        // count with the six inertia integrals of the 3D element
         let (rigid, per_element, matrices, weld) = if three {
-            (7u64, 6u64, 10u64, 6u64)
+            (7u64, 6u64, 14u64, 6u64)
         } else {
-            (3, 3, 5, 3)
+            (3, 3, 8, 3)
         };
         let (mut n, mut m, mut frame_bytes, mut shape) = (0u64, 0u64, 0u64, 0u64);
         for b in &self.beams {
