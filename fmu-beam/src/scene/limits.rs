@@ -58,11 +58,10 @@ pub(super) fn size(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         ));
     }
     if size.variables > r::MAX_VARIABLES {
-        return Err(ck.fail_with(
+        return Err(ck.fail(
             &r::VARIABLES_MAX,
             "beam",
-            format!("{} variables", size.variables),
-            &format!(": about {} here", size.variables),
+            format!("about {} variables", size.variables),
         ));
     }
     Ok(())
