@@ -81,6 +81,14 @@ def scene_of(case):
     for path, value in case.get("set", {}).items():
         parent, key = slot(doc, path)
         parent[key] = value
+    for path, length in case.get("repeat", {}).items():
+        parent, key = slot(doc, path)
+        items = parent[key]
+        while len(items) < length:
+            item = copy.deepcopy(items[-1])
+            if isinstance(item, dict) and isinstance(item.get("name"), str):
+                item["name"] = f"{item['name']}_{len(items)}"
+            items.append(item)
     return doc
 
 

@@ -276,3 +276,293 @@ fn a_vanishing_max_step_is_refused_not_a_hang() {
     assert!(err.to_string().contains("solver.max_step"), "{err}");
     e.do_step(0.0, 1e-3).unwrap();
 }
+
+// Hostile scenes (issue 35): what a scene names is read only below its directory, only if it is
+// a regular file within its cap, and no refusal shows what a file holds; what a scene sizes is
+// refused at once, with the figure and the limit, never a panic or an allocation that aborts.
+
+/// Marks the text of a file that must not reach a message.
+const SECRET: &str = "root:SECRET-7f3a9:20228:0:99999";
+
+/// A scratch directory holding a copy of the 3D matrix scene and its matrix file, and a
+/// secret file one level up.
+fn hostile_dir(name: &str) -> std::path::PathBuf {
+    let base = Path::new(env!("CARGO_TARGET_TMPDIR")).join("hostile_scenes");
+    let dir = base.join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("matrices")).unwrap();
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    std::fs::copy(
+        scenes.join("matrices/pendulum_3d_element.txt"),
+        dir.join("matrices/pendulum_3d_element.txt"),
+    )
+    .unwrap();
+    // a file that parses as a matrix file, with the secret in a comment, outside the scene's dir
+    let good = std::fs::read_to_string(scenes.join("matrices/pendulum_3d_element.txt")).unwrap();
+    std::fs::write(
+        base.join(format!("{name}_outside.txt")),
+        format!("# {SECRET}\n{good}"),
+    )
+    .unwrap();
+    dir
+}
+
+fn matrix_scene(matrix_file: &str) -> String {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/pendulum_3d_matrix.toml"),
+    )
+    .unwrap();
+    let from = "matrix_file = \"matrices/pendulum_3d_element.txt\"";
+    assert!(text.contains(from));
+    text.replace(from, &format!("matrix_file = {matrix_file:?}"))
+}
+
+/// Loads `scene` written into `dir`, expects a refusal within a second, and returns its message,
+/// checked to name the scene file and the field and to hold nothing of the secret.
+fn refused_load(dir: &Path, scene: &str, words: &[&str]) -> String {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let start = std::time::Instant::now();
+    let err = Scene::load(&path).expect_err("must be refused");
+    let took = start.elapsed().as_secs_f64();
+    let msg = err.to_string();
+    assert!(took < 1.0, "{took} s: {msg}");
+    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+    assert!(!msg.contains("SECRET"), "the message shows the file: {msg}");
+    for w in words {
+        assert!(msg.contains(w), "{w:?} not in {msg}");
+    }
+    assert!(msg.len() < 1000, "{} bytes: {msg}", msg.len());
+    msg
+}
+
+#[test]
+fn a_matrix_file_is_read_only_below_the_scene_and_only_if_regular() {
+    let dir = hostile_dir("outside");
+    // the copy beside the scene is read
+    std::fs::write(
+        dir.join("scene.toml"),
+        matrix_scene("matrices/pendulum_3d_element.txt"),
+    )
+    .unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap();
+    let field = "beam[0].matrix_file";
+    // absolute, `..`, and a link inside the directory that points out
+    refused_load(
+        &dir,
+        &matrix_scene("/etc/passwd"),
+        &[field, "below the scene file's directory"],
+    );
+    refused_load(
+        &dir,
+        &matrix_scene("../outside_outside.txt"),
+        &[field, "below the scene file's directory"],
+    );
+    std::os::unix::fs::symlink(dir.join("../outside_outside.txt"), dir.join("link.txt")).unwrap();
+    refused_load(
+        &dir,
+        &matrix_scene("link.txt"),
+        &[field, "below the scene file's directory"],
+    );
+    refused_load(&dir, &matrix_scene("/proc/self/environ"), &[field]);
+    // a link inside that stays inside is followed
+    std::os::unix::fs::symlink(
+        dir.join("matrices/pendulum_3d_element.txt"),
+        dir.join("inside.txt"),
+    )
+    .unwrap();
+    std::fs::write(dir.join("scene.toml"), matrix_scene("inside.txt")).unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap();
+    // a directory, a FIFO (never opened: opening it would block), a file over the cap
+    refused_load(
+        &dir,
+        &matrix_scene("matrices"),
+        &[field, "regular file", "directory"],
+    );
+    let status = std::process::Command::new("mkfifo")
+        .arg(dir.join("fifo.txt"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    refused_load(
+        &dir,
+        &matrix_scene("fifo.txt"),
+        &[field, "regular file", "FIFO"],
+    );
+    std::fs::write(dir.join("big.txt"), vec![b'#'; 70_000]).unwrap();
+    refused_load(
+        &dir,
+        &matrix_scene("big.txt"),
+        &[field, "at most 65536 bytes", "70000"],
+    );
+}
+
+#[test]
+fn a_scene_file_that_is_a_device_a_fifo_or_huge_is_refused_at_once() {
+    let dir = hostile_dir("devices");
+    for path in ["/dev/zero", "/dev/urandom"] {
+        let start = std::time::Instant::now();
+        let err = Scene::load(Path::new(path)).unwrap_err().to_string();
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{path}: {err}");
+        assert!(err.contains("regular file"), "{err}");
+    }
+    let fifo = dir.join("scene_fifo.toml");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let err = Scene::load(&fifo).unwrap_err().to_string();
+    assert!(err.contains("FIFO"), "{err}");
+    let huge = dir.join("huge.toml");
+    std::fs::write(&huge, vec![b'#'; (4 << 20) + 1]).unwrap();
+    let err = Scene::load(&huge).unwrap_err().to_string();
+    assert!(err.contains("at most 4194304 bytes"), "{err}");
+}
+
+#[test]
+fn a_file_that_fails_to_parse_is_not_shown() {
+    let dir = hostile_dir("unparsed");
+    let good = std::fs::read_to_string(dir.join("matrices/pendulum_3d_element.txt")).unwrap();
+    // the secret where the parser stops: first word, a row's number, the length's value
+    let cases = [
+        format!("{SECRET}\n{good}"),
+        format!("{SECRET} mass\n"),
+        good.replacen("length 0.2", &format!("length {SECRET}"), 1),
+        {
+            let mut lines: Vec<String> = good.lines().map(String::from).collect();
+            let k = lines.iter().position(|l| l.starts_with("mass")).unwrap() + 3;
+            lines[k] = lines[k].replacen(' ', &format!(" {SECRET} "), 1);
+            lines.join("\n")
+        },
+    ];
+    for (k, text) in cases.iter().enumerate() {
+        std::fs::write(dir.join("bad.txt"), text).unwrap();
+        let msg = refused_load(&dir, &matrix_scene("bad.txt"), &["bad.txt"]);
+        println!("case {k}: {msg}");
+    }
+    // a scene whose TOML breaks on a 200 KB line: line and column, not the line
+    let mut scene = matrix_scene("matrices/pendulum_3d_element.txt");
+    scene.push_str(&format!("\n[oops\n# {}{SECRET}\n", "x".repeat(200_000)));
+    let msg = refused_load(&dir, &scene, &["TOML parse error at line"]);
+    println!("{msg}");
+    let long_value = matrix_scene("matrices/pendulum_3d_element.txt").replace(
+        "name = \"hinge\"",
+        &format!(
+            "name = \"hinge\"\naxis_angle = \"{}{SECRET}\"",
+            "y".repeat(200_000)
+        ),
+    );
+    let msg = refused_load(&dir, &long_value, &["TOML parse error at line"]);
+    println!("{msg}");
+}
+
+/// A scene of C1 with `from` replaced by `to`.
+fn c1_with(from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cantilever_free_vibration.toml"),
+    )
+    .unwrap();
+    assert!(text.contains(from), "{from}");
+    text.replacen(from, to, 1)
+}
+
+/// Refused within a second, naming `words`, in a short message.
+fn refused_fast(text: &str, words: &[&str]) -> String {
+    let start = std::time::Instant::now();
+    let err = Scene::from_toml_str(text, "hostile.toml").expect_err("must be refused");
+    let msg = err.to_string();
+    assert!(start.elapsed().as_secs_f64() < 1.0, "{msg}");
+    assert!(msg.len() < 1000, "{} bytes: {msg}", msg.len());
+    for w in words {
+        assert!(msg.contains(w), "{w:?} not in {msg}");
+    }
+    msg
+}
+
+#[test]
+fn long_names_are_refused_with_their_length_not_a_panic() {
+    let c1 = c1_with("name = \"cantilever_free_vibration\"", "name = \"c1\"");
+    for n in [65, 5000, 70_000] {
+        let long = "m".repeat(n);
+        let text = c1.replacen("name = \"c1\"", &format!("name = \"{long}\""), 1);
+        let msg = refused_fast(&text, &["field `name`", "at most 64 characters"]);
+        assert!(msg.contains(&format!("{n}")), "{msg}");
+    }
+    // the beam's name, 65 535 characters (a part name), and a frame of a body
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/flexible_arm_hub.toml"),
+    )
+    .unwrap();
+    let scene: Value = toml::from_str(&text).unwrap();
+    let beam_name = scene["beam"][0]["name"].as_str().unwrap().to_string();
+    let long = "b".repeat(65_535);
+    let text = text.replace(&format!("\"{beam_name}"), &format!("\"{long}"));
+    refused_fast(&text, &["beam[0].name", "at most 64 characters", "65535"]);
+    // 64 is allowed
+    let ok = c1.replacen(
+        "name = \"c1\"",
+        &format!("name = \"{}\"", "m".repeat(64)),
+        1,
+    );
+    Scene::from_toml_str(&ok, "ok.toml").unwrap();
+}
+
+#[test]
+fn sizes_beyond_the_limits_are_refused_at_once() {
+    let sub = c1_with(
+        "elements = 10",
+        "substructures = 500\nelements_per_substructure = 2000",
+    );
+    refused_fast(
+        &sub,
+        &["beam[0].substructures", "500 × 2000", "at most 2000"],
+    );
+    let big = c1_with("elements = 10", "elements = 2000");
+    refused_fast(&big, &["field `beam`", "1 GiB", "MiB"]);
+    let fine = c1_with("elements = 10", "elements = 500");
+    Scene::from_toml_str(&fine, "fine.toml").unwrap();
+    let points = c1_with("elements = 10", "elements = 10\nshape_points = 1000");
+    Scene::from_toml_str(&points, "points.toml").unwrap();
+}
+
+#[test]
+fn a_joint_has_two_frames_and_a_vector_its_count_of_numbers() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/flexible_pendulum.toml"),
+    )
+    .unwrap();
+    let frames = text
+        .lines()
+        .find(|l| l.starts_with("frames = ["))
+        .unwrap()
+        .to_string();
+    let three = frames.replacen('[', "[\"world\", ", 1);
+    refused_fast(
+        &text.replacen(&frames, &three, 1),
+        &["invalid length 3", "exactly 2 frames"],
+    );
+    let one = "frames = [\"world\"]";
+    refused_fast(
+        &text.replacen(&frames, one, 1),
+        &["invalid length 1", "exactly 2 frames"],
+    );
+    let five = c1_with("[[beam]]", "[[beam]]\nposition = [0.0, 0.0, 0.0, 0.0, 0.0]");
+    refused_fast(
+        &five,
+        &["invalid length 5", "2 numbers [x, y] or 3 numbers"],
+    );
+    let d3 = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/pendulum_3d.toml"),
+    )
+    .unwrap();
+    let axis = d3
+        .lines()
+        .find(|l| l.starts_with("axis = ["))
+        .unwrap()
+        .to_string();
+    refused_fast(
+        &d3.replacen(&axis, "axis = [0.0, 1.0]", 1),
+        &["invalid length 2", "3 numbers [x, y, z]"],
+    );
+}

@@ -72,6 +72,21 @@ fn scene_text(all: &Value, case: &Value) -> String {
             *slot(&mut doc, path) = v.clone();
         }
     }
+    if let Some(Value::Table(repeat)) = case.get("repeat") {
+        for (path, length) in repeat {
+            let length = length.as_integer().unwrap() as usize;
+            let Value::Array(items) = slot(&mut doc, path) else {
+                panic!("repeat {path}: not an array");
+            };
+            while items.len() < length {
+                let mut item = items.last().unwrap().clone();
+                if let Some(Value::String(name)) = item.get_mut("name") {
+                    *name = format!("{name}_{}", items.len());
+                }
+                items.push(item);
+            }
+        }
+    }
     for beam in doc
         .get_mut("beam")
         .and_then(Value::as_array_mut)
@@ -142,4 +157,50 @@ fn every_rule_refuses_its_scenes_with_its_code_and_field() {
             rule.code
         );
     }
+}
+
+/// Every shipped scene (scenes/, examples/) is within the limits (issue 35), and the estimate
+/// of a unit's variables that the `variables_max` rule uses bounds the table the unit builds,
+/// also with many shape points and parts.
+#[test]
+fn shipped_scenes_are_within_the_limits_and_the_variable_estimate_bounds_the_table() {
+    let mut paths = Vec::new();
+    for dir in [
+        "scenes",
+        "examples/split_slider_crank",
+        "examples/hinged_blade",
+    ] {
+        for e in std::fs::read_dir(repo().join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                paths.push(p);
+            }
+        }
+    }
+    let mut checked = 0;
+    for p in &paths {
+        let text = std::fs::read_to_string(p).unwrap();
+        // the examples' system files are not scenes
+        if !text.contains("[[beam]]") {
+            continue;
+        }
+        let scene = Scene::load(p).unwrap_or_else(|e| panic!("{e}"));
+        let size = scene.size();
+        let table = fmu_beam::VariableTable::build(&scene).variables.len() as u64;
+        assert!(
+            table <= size.variables,
+            "{}: {table} > {size:?}",
+            p.display()
+        );
+        assert!(size.memory < 64 << 20, "{}: {size:?}", p.display());
+        let mut more = scene.clone();
+        for b in &mut more.beams {
+            b.shape_points = Some(1000);
+            b.outputs.clear();
+        }
+        let table = fmu_beam::VariableTable::build(&more).variables.len() as u64;
+        assert!(table <= more.size().variables, "{}: {table}", p.display());
+        checked += 1;
+    }
+    assert!(checked >= 25, "{checked} scenes");
 }

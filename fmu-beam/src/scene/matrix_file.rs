@@ -18,6 +18,14 @@
 //! `length`, `mass` and `stiffness` each appear exactly once, in any order; numbers are Rust
 //! `f64` literals (`1e-3`, `-2.5E+4`) and must be finite.
 //!
+//! # What a refusal shows of the file
+//! The file, the line and column, and what was expected there; of the text itself, only a
+//! word of at most [`QUOTED`] characters of digits, letters, `.`, `+`, `-` and `_`, and only
+//! where the file has shown itself a matrix file (a number of a block, the value after
+//! `length`) or where it misspells a keyword. A file that is not one (a scene naming
+//! `/etc/shadow` by mistake or by malice) is refused with its first line and column and
+//! nothing of its content.
+//!
 //! # Rules (each refusal names the file, the line and the rule)
 //! - symmetric: |a_ij − a_ji| ≤ [`SYMMETRY_TOLERANCE`] · max |a| (relative to the largest
 //!   entry: FE tools print to 6–16 digits, so a mismatch at that level is rounding);
@@ -36,6 +44,8 @@ pub const SIZE: usize = 12;
 pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 /// Relative tolerance of the semi-definiteness rule (to the largest eigenvalue).
 pub const EIGEN_TOLERANCE: f64 = 1e-9;
+/// Longest word of a file that a refusal quotes (characters).
+pub const QUOTED: usize = 24;
 /// Relative tolerance of the rigid-motion rule (to the largest entry times the mode's size).
 pub const RIGID_TOLERANCE: f64 = 1e-9;
 
@@ -64,12 +74,14 @@ pub enum MatrixFileError {
     },
     /// A line that breaks the format (an unknown keyword, a row of other than 12 numbers, a
     /// block or `length` given twice, …).
-    #[error("{file}:{line}: {rule}")]
+    #[error("{file}:{line}:{column}: {rule}")]
     Syntax {
         /// The file, as the caller named it.
         file: String,
         /// The offending line (1-based).
         line: usize,
+        /// The column (1-based, in characters) of the offending word, 1 for a whole line.
+        column: usize,
         /// What the format asks for there.
         rule: String,
     },
@@ -152,6 +164,44 @@ pub enum MatrixFileError {
     },
 }
 
+/// A word of the file as a message may show it: quoted if short and made of the characters of
+/// numbers and keywords, else only its length.
+fn shown(word: &str) -> String {
+    let n = word.chars().count();
+    let plain = word
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '+' | '-' | '_'));
+    if plain && n <= QUOTED {
+        format!("`{word}`")
+    } else {
+        format!("a word of {n} characters")
+    }
+}
+
+/// Edit distance of two short words (insertions, deletions, substitutions).
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let here = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb))
+                .min(row[j] + 1)
+                .min(here + 1);
+            prev = here;
+        }
+    }
+    row[b.len()]
+}
+
+/// Column (1-based, in characters) where `word`, a slice of `line`, starts.
+fn column_of(line: &str, word: &str) -> usize {
+    let at = (word.as_ptr() as usize).saturating_sub(line.as_ptr() as usize);
+    line.get(..at).map_or(0, |s| s.chars().count()) + 1
+}
+
 /// A block being read: name, header line, rows with their line numbers.
 struct Block {
     name: &'static str,
@@ -161,9 +211,10 @@ struct Block {
 
 /// Parses and checks the text of a matrix file; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
-    let syntax = |line: usize, rule: String| MatrixFileError::Syntax {
+    let syntax = |line: usize, column: usize, rule: String| MatrixFileError::Syntax {
         file: file.to_string(),
         line,
+        column,
         rule,
     };
     let mut length: Option<(usize, f64)> = None;
@@ -187,6 +238,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
             if keyword.is_some() {
                 return Err(syntax(
                     line,
+                    column_of(raw, first),
                     format!(
                         "the {} block (line {}) has {} rows before `{first}`; it needs 12 rows \
                          of 12 numbers",
@@ -201,13 +253,19 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 let x: f64 = token.parse().map_err(|_| {
                     syntax(
                         line,
-                        format!("`{token}` in the {} block is not a number", block.name),
+                        column_of(raw, token),
+                        format!(
+                            "{} in the {} block is not a number",
+                            shown(token),
+                            block.name
+                        ),
                     )
                 })?;
                 if !x.is_finite() {
                     return Err(syntax(
                         line,
-                        format!("`{token}` in the {} block is not finite", block.name),
+                        column_of(raw, token),
+                        format!("{} in the {} block is not finite", shown(token), block.name),
                     ));
                 }
                 row.push(x);
@@ -215,6 +273,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
             if row.len() != SIZE {
                 return Err(syntax(
                     line,
+                    column_of(raw, content),
                     format!(
                         "row {} of the {} block needs 12 numbers, found {}",
                         block.rows.len() + 1,
@@ -225,7 +284,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
             }
             block.rows.push((line, row));
             if block.rows.len() == SIZE {
-                done.push(open.take().unwrap());
+                done.extend(open.take());
             }
             continue;
         }
@@ -234,6 +293,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 if let Some((first_line, _)) = length {
                     return Err(syntax(
                         line,
+                        column_of(raw, first),
                         format!("`length` given more than once (first on line {first_line})"),
                     ));
                 }
@@ -242,13 +302,17 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 match (x, words.next()) {
                     (Some(x), None) if x.is_finite() && x > 0.0 => length = Some((line, x)),
                     _ => {
+                        let rest = content.get("length".len()..).unwrap_or("").trim();
+                        let found = match rest.split_whitespace().count() {
+                            0 => "nothing".to_string(),
+                            1 => shown(rest),
+                            n => format!("{n} words"),
+                        };
                         return Err(syntax(
                             line,
-                            format!(
-                                "`length` needs one positive finite number (m), found `{}`",
-                                content["length".len()..].trim()
-                            ),
-                        ))
+                            column_of(raw, first),
+                            format!("`length` needs one positive finite number (m), found {found}"),
+                        ));
                     }
                 }
             }
@@ -256,6 +320,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 if let Some(prev) = done.iter().find(|b| b.name == name) {
                     return Err(syntax(
                         line,
+                        column_of(raw, first),
                         format!(
                             "the {name} block is given more than once (first on line {})",
                             prev.header
@@ -265,6 +330,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 if words.next().is_some() {
                     return Err(syntax(
                         line,
+                        column_of(raw, first),
                         format!("`{name}` stands alone on its line; its 12 rows follow"),
                     ));
                 }
@@ -275,10 +341,20 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 });
             }
             None => {
+                // a misspelt keyword is named; anything else only measured
+                let near = ["length", "mass", "stiffness"]
+                    .iter()
+                    .any(|k| first.len() <= 12 && distance(first, k) <= 2);
+                let found = if near {
+                    shown(first)
+                } else {
+                    format!("a word of {} characters", first.chars().count())
+                };
                 return Err(syntax(
                     line,
-                    format!("unknown keyword `{first}`: expected `length`, `mass` or `stiffness`"),
-                ))
+                    column_of(raw, first),
+                    format!("unknown keyword {found}: expected `length`, `mass` or `stiffness`"),
+                ));
             }
         }
     }
@@ -402,13 +478,17 @@ fn check_rigid_motion(
 }
 
 impl MatrixFile {
-    /// Reads and checks a matrix file.
+    /// Reads and checks a matrix file: a regular file of at most
+    /// [`super::files::MAX_MATRIX_FILE_BYTES`].
     pub fn load(path: &Path) -> Result<MatrixFile, MatrixFileError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| MatrixFileError::Io {
-            file: file.clone(),
-            message: e.to_string(),
-        })?;
+        let text =
+            super::files::read_capped(path, super::files::MAX_MATRIX_FILE_BYTES).map_err(|e| {
+                MatrixFileError::Io {
+                    file: file.clone(),
+                    message: e.to_string(),
+                }
+            })?;
         parse(&text, &file)
     }
 

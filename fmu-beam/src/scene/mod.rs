@@ -7,9 +7,12 @@
 //! Over 600 lines on purpose: the format's spec structs, whose doc comments are the generated scene
 //! reference, read in one place.
 
+pub mod files;
+mod limits;
 pub mod matrix_file;
 mod planar;
 pub mod rules;
+mod size;
 mod space;
 mod validate;
 pub mod xyz;
@@ -17,6 +20,7 @@ pub mod xyz;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
 pub use validate::SceneError;
 
@@ -510,6 +514,8 @@ pub struct JointSpec {
     pub kind: JointKind,
     /// The two frames the joint connects: `world`, `<beam>.a`, `<beam>.b`, `<body>.<frame>`;
     /// a prismatic joint slides along the x axis of the first, turned by `axis_angle`.
+    #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::pair"))]
+    #[serde(with = "xyz::pair")]
     pub frames: [String; 2],
     /// Planar prismatic joint: angle of the sliding axis from the first frame's x axis.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "rad")))]
@@ -650,30 +656,67 @@ impl Scene {
         Ok(scene)
     }
 
+    /// Parses scene text of at most [`files::MAX_SCENE_BYTES`]; a refusal says where (line,
+    /// column) and what the parser expected, never the text around it.
     fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
-        toml::from_str(text).map_err(|e| SceneError::Parse {
-            origin: origin.to_string(),
-            message: e.to_string().trim_end().to_string(),
+        if text.len() as u64 > files::MAX_SCENE_BYTES {
+            return Err(SceneError::Io {
+                origin: origin.to_string(),
+                message: files::FileRefusal::TooLarge {
+                    size: text.len().to_string(),
+                    cap: files::MAX_SCENE_BYTES,
+                }
+                .to_string(),
+            });
+        }
+        toml::from_str(text).map_err(|e| {
+            let at = match e.span() {
+                Some(span) => {
+                    let start = span.start.min(text.len());
+                    let before = text.get(..start).unwrap_or("");
+                    let line = before.matches('\n').count() + 1;
+                    let line_start = before.rfind('\n').map_or(0, |k| k + 1);
+                    let column = before.get(line_start..).map_or(0, |l| l.chars().count()) + 1;
+                    format!(" at line {line}, column {column}")
+                }
+                None => String::new(),
+            };
+            SceneError::Parse {
+                origin: origin.to_string(),
+                message: format!(
+                    "TOML parse error{at}: {}",
+                    limits::abbreviate(e.message().trim_end(), 300)
+                ),
+            }
         })
     }
 
-    /// Reads, parses and validates a scene file; a beam's `matrix_file` is read (relative to
-    /// the scene file) into its `matrix_text`, unless the text is there already.
+    /// Reads, parses and validates a scene file; a beam's `matrix_file` is read into its
+    /// `matrix_text`, unless the text is there already. Each file is read only if it is a
+    /// regular file within its cap ([`files::MAX_SCENE_BYTES`],
+    /// [`files::MAX_MATRIX_FILE_BYTES`]); a matrix file must lie below the scene file's
+    /// directory (links followed, [`files::resolve_below`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
-            origin: origin.clone(),
-            message: e.to_string(),
-        })?;
+        let text =
+            files::read_capped(path, files::MAX_SCENE_BYTES).map_err(|e| SceneError::Io {
+                origin: origin.clone(),
+                message: e.to_string(),
+            })?;
         let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         for (i, b) in scene.beams.iter_mut().enumerate() {
             // a packaged scene carries the text already
             if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
-                let text = std::fs::read_to_string(dir.join(file)).map_err(|e| SceneError::Io {
-                    origin: format!("{origin}: beam[{i}].matrix_file = {file:?}"),
-                    message: e.to_string(),
-                })?;
+                let refuse = |e: files::FileRefusal| SceneError::File {
+                    origin: origin.clone(),
+                    field: format!("beam[{i}].matrix_file"),
+                    file: limits::abbreviate(&format!("{file:?}"), 200),
+                    rule: e.to_string(),
+                };
+                let resolved = files::resolve_below(dir, file).map_err(refuse)?;
+                let text =
+                    files::read_capped(&resolved, files::MAX_MATRIX_FILE_BYTES).map_err(refuse)?;
                 b.matrix_text = Some(text);
             }
         }

@@ -139,6 +139,28 @@ pub const LAW_PARAMETERS: [(&str, &[&str]); 4] = [
     ("table", &["table"]),
 ];
 
+/// Longest name of the scene, a beam, a body, a joint, a load or a body's frame (characters):
+/// names become FMI variable names (`<beam>.shape.x[12]`) and the scene's name the file name of
+/// the unit's binary (`<name>.so`, at most 255 bytes on Linux), which a master must open.
+pub const MAX_NAME_LENGTH: usize = 64;
+/// Longest `description` (characters): a line or a paragraph of modelDescription.xml.
+pub const MAX_DESCRIPTION_LENGTH: usize = 1000;
+/// Most beams of a scene.
+pub const MAX_BEAMS: usize = 100;
+/// Most rigid bodies, joints and loads of a scene (each).
+pub const MAX_PARTS: usize = 1000;
+/// Most rows of a `table` law.
+pub const MAX_TABLE_ROWS: usize = 10_000;
+/// Most elements of one beam, however split: `elements`, or `substructures` ×
+/// `elements_per_substructure`.
+pub const MAX_BEAM_ELEMENTS: usize = 2000;
+/// Most memory a unit may need for its matrices (bytes, [`crate::scene::Size::memory`]): 1 GiB,
+/// about 8000 unknowns n + m with a dense iteration matrix.
+pub const MAX_UNIT_MEMORY: u64 = 1 << 30;
+/// Most FMU variables of a unit ([`crate::scene::Size::variables`]): a modelDescription.xml of
+/// some 10 MB, which masters still read in a moment.
+pub const MAX_VARIABLES: u64 = 20_000;
+
 const IDENTIFIER: &str = "must be an identifier (letters, digits, _; not starting with a digit)";
 const ONLY_3D: &str = "is for 3D scenes (dimensions = 3)";
 const PLANE: &str =
@@ -199,6 +221,62 @@ pub(crate) const SCENE_NAME: Rule = rule(
     IDENTIFIER,
     Any,
     Schema::Identifier(&[]),
+);
+pub(crate) const NAME_LENGTH: Rule = rule(
+    "name_length",
+    &[
+        "name",
+        "beam[].name",
+        "body[].name",
+        "joint[].name",
+        "load[].name",
+        "body[].frames.<name>",
+    ],
+    "must be at most 64 characters (names become FMI variable names, the scene's name the binary's file name)",
+    Any,
+    Schema::None,
+);
+pub(crate) const DESCRIPTION_LENGTH: Rule = rule(
+    "description_length",
+    &["description"],
+    "must be at most 1000 characters",
+    Any,
+    Schema::None,
+);
+pub(crate) const PARTS_MAX: Rule = rule(
+    "parts_max",
+    &["beam", "body", "joint", "load"],
+    "a scene has at most 100 beams and 1000 each of bodies, joints and loads",
+    Any,
+    Schema::None,
+);
+pub(crate) const TABLE_ROWS_MAX: Rule = rule(
+    "table_rows_max",
+    &["joint[].drive.table", "load[].scale.table"],
+    "a table has at most 10000 rows",
+    Any,
+    Schema::None,
+);
+pub(crate) const BEAM_ELEMENTS_MAX: Rule = rule(
+    "beam_elements_max",
+    &["beam[].substructures"],
+    "substructures × elements_per_substructure must be at most 2000 (the elements of one beam)",
+    Any,
+    Schema::None,
+);
+pub(crate) const UNIT_MEMORY: Rule = rule(
+    "unit_memory",
+    &["beam"],
+    "the unit's matrices must fit in 1 GiB (1073741824 bytes; fewer elements or substructures)",
+    Any,
+    Schema::None,
+);
+pub(crate) const VARIABLES_MAX: Rule = rule(
+    "variables_max",
+    &["beam"],
+    "the unit must have at most 20000 FMU variables (fewer shape points, beams or parts)",
+    Any,
+    Schema::None,
 );
 pub(crate) const DIMENSIONS: Rule = rule(
     "dimensions",
@@ -769,6 +847,9 @@ pub const RULES: &[Rule] = &[
     POSITIVE,
     NON_NEGATIVE,
     SCENE_NAME,
+    NAME_LENGTH,
+    DESCRIPTION_LENGTH,
+    PARTS_MAX,
     DIMENSIONS,
     SPATIAL_FORMULATION,
     EFFECTS_MODE,
@@ -789,6 +870,9 @@ pub const RULES: &[Rule] = &[
     AT_LEAST_ONE,
     ELEMENTS_MAX,
     SUBSTRUCTURES_MAX,
+    BEAM_ELEMENTS_MAX,
+    UNIT_MEMORY,
+    VARIABLES_MAX,
     LAYOUT_MISSING,
     LAYOUT_PER_SUBSTRUCTURE,
     LAYOUT_EITHER,
@@ -836,6 +920,7 @@ pub const RULES: &[Rule] = &[
     LAW,
     LAW_PARAMETER,
     TABLE_ROWS,
+    TABLE_ROWS_MAX,
     TABLE_TIMES,
     LOAD_FRAME,
     LOAD_ON_BODY,
@@ -929,6 +1014,21 @@ mod tests {
             .text
             .ends_with(&super::super::SPATIAL_EFFECTS.join(", ")));
         assert!(PART_NAME.text.ends_with(&RESERVED_NAMES.join(", ")));
+        let quotes = |r: &Rule, n: &str| assert!(r.text.contains(n), "{}: {n}", r.code);
+        quotes(
+            &NAME_LENGTH,
+            &format!("at most {MAX_NAME_LENGTH} characters"),
+        );
+        quotes(
+            &DESCRIPTION_LENGTH,
+            &format!("at most {MAX_DESCRIPTION_LENGTH} characters"),
+        );
+        quotes(&PARTS_MAX, &format!("at most {MAX_BEAMS} beams"));
+        quotes(&PARTS_MAX, &format!("{MAX_PARTS} each"));
+        quotes(&TABLE_ROWS_MAX, &format!("at most {MAX_TABLE_ROWS} rows"));
+        quotes(&BEAM_ELEMENTS_MAX, &format!("at most {MAX_BEAM_ELEMENTS}"));
+        quotes(&UNIT_MEMORY, &format!("({MAX_UNIT_MEMORY} bytes"));
+        quotes(&VARIABLES_MAX, &format!("at most {MAX_VARIABLES} FMU"));
     }
 
     #[test]

@@ -18,12 +18,25 @@ pub enum SceneError {
         /// The system's error.
         message: String,
     },
+    /// A file the scene names is refused before it is read: outside the scene's directory, not
+    /// a regular file, over its cap, not text.
+    #[error("{origin}: field `{field}` = {file}: {rule}")]
+    File {
+        /// The scene file's path.
+        origin: String,
+        /// The field that names the file, such as `beam[0].matrix_file`.
+        field: String,
+        /// The name as the scene wrote it (quoted).
+        file: String,
+        /// The rule it breaks ([`super::files::FileRefusal`]).
+        rule: String,
+    },
     /// The text is not TOML, or not of the scene's shape (unknown field, wrong type, …).
     #[error("{origin}: {message}")]
     Parse {
         /// Where the text came from: a path, or what the caller named it.
         origin: String,
-        /// The TOML parser's message, with its line and column.
+        /// The TOML parser's message, with its line and column (never the text there).
         message: String,
     },
     /// A value that breaks one of the scene's rules ([`Rule`]).
@@ -69,7 +82,7 @@ impl Checker<'_> {
         SceneError::Invalid {
             origin: self.origin.to_string(),
             field: field.to_string(),
-            value: value.to_string(),
+            value: super::limits::abbreviate(&value.to_string(), 80),
             rule: format!("{}{detail}", rule.text),
             code: rule.code,
         }
@@ -122,9 +135,12 @@ pub(super) fn is_identifier(s: &str) -> bool {
 impl Scene {
     pub(crate) fn validate(&self, origin: &str) -> Result<(), SceneError> {
         let ck = Checker { origin };
+        super::limits::parts(&ck, self)?;
+        super::limits::name_fits(&ck, "name", &self.name)?;
         if !is_identifier(&self.name) {
             return Err(ck.fail(&r::SCENE_NAME, "name", format!("{:?}", self.name)));
         }
+        super::limits::description(&ck, self)?;
         if !matches!(self.dimensions, 2 | 3) {
             return Err(ck.fail(&r::DIMENSIONS, "dimensions", self.dimensions));
         }
@@ -168,6 +184,7 @@ impl Scene {
                 ));
             }
         }
+        super::limits::size(&ck, self)?;
         validate_effects(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
             validate_body(&ck, b, i, self.is_3d())?;
@@ -197,6 +214,7 @@ impl Scene {
                     .map(|(i, l)| (&l.name, format!("load[{i}].name"))),
             );
         for (name, field) in all {
+            super::limits::name_fits(&ck, &field, name)?;
             if !is_identifier(name) || r::RESERVED_NAMES.contains(&name.as_str()) {
                 return Err(ck.fail(&r::PART_NAME, &field, format!("{name:?}")));
             }
@@ -324,6 +342,7 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
 
 fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<(), SceneError> {
     let f = |name: &str| format!("beam[{i}].{name}");
+    super::limits::name_fits(ck, &f("name"), &b.name)?;
     if !is_identifier(&b.name) {
         return Err(ck.fail(&r::SCENE_NAME, &f("name"), format!("{:?}", b.name)));
     }
@@ -343,6 +362,14 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<()
         (None, Some(k), Some(n)) => {
             count("substructures", k, (500, &r::SUBSTRUCTURES_MAX))?;
             count("elements_per_substructure", n, ELEMENTS)?;
+            let all = k.saturating_mul(n);
+            if all > r::MAX_BEAM_ELEMENTS {
+                return Err(ck.fail(
+                    &r::BEAM_ELEMENTS_MAX,
+                    &f("substructures"),
+                    format!("{k} × {n} = {all}"),
+                ));
+            }
         }
         (None, None, _) => return Err(ck.fail(&r::LAYOUT_MISSING, &f("elements"), "missing")),
         (None, Some(_), None) => {
@@ -539,15 +566,13 @@ fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Resu
     }
     ck.finite(&f("angle"), b.angle)?;
     for (name, p) in &b.frames {
+        let field = f(&format!("frames.{}", super::limits::abbreviate(name, 80)));
+        super::limits::name_fits(ck, &field, name)?;
         if !is_identifier(name) || name == "a" || name == "b" {
-            return Err(ck.fail(
-                &r::FRAME_NAME,
-                &f(&format!("frames.{name}")),
-                format!("{name:?}"),
-            ));
+            return Err(ck.fail(&r::FRAME_NAME, &field, format!("{name:?}")));
         }
         for k in 0..3 {
-            ck.finite(&f(&format!("frames.{name}[{k}]")), p.0[k])?;
+            ck.finite(&format!("{field}[{k}]"), p.0[k])?;
         }
     }
     Ok(())
@@ -586,6 +611,9 @@ pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(),
             let t = l.table.as_ref().ok_or_else(|| {
                 ck.fail_with(&r::LAW_PARAMETER, &f("table"), "missing", " \"table\"")
             })?;
+            if t.len() > r::MAX_TABLE_ROWS {
+                return Err(ck.fail(&r::TABLE_ROWS_MAX, &f("table"), t.len()));
+            }
             if t.len() < 2 {
                 return Err(ck.fail(&r::TABLE_ROWS, &f("table"), t.len()));
             }

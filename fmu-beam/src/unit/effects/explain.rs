@@ -4,6 +4,10 @@
 
 use super::*;
 
+/// Widest column of the tables (characters): a longer cell runs past its column rather than
+/// widening it (a format width above 65 535 panics).
+const WIDEST: usize = 100;
+
 impl Resolution {
     /// The explanation as text: one line per decision, then the cost model's total.
     pub fn explain(&self, scene: &Scene) -> String {
@@ -16,13 +20,15 @@ impl Resolution {
             .iter()
             .map(|d| d.effect.len() + d.subject.len() + 3)
             .max()
-            .unwrap_or(10);
+            .unwrap_or(10)
+            .min(WIDEST);
         let ws = self
             .decisions
             .iter()
             .map(|d| d.setting.len())
             .max()
-            .unwrap_or(3);
+            .unwrap_or(3)
+            .min(WIDEST);
         s += &format!(
             "{:<w$}  {:<ws$}  {:>6}  why\n",
             "effect (subject)", "setting", "cost"
@@ -88,8 +94,18 @@ impl Resolution {
         if rows.is_empty() {
             return String::new();
         }
-        let w = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
-        let ws = rows.iter().map(|r| r.1.len()).max().unwrap_or(0);
+        let w = rows
+            .iter()
+            .map(|r| r.0.len())
+            .max()
+            .unwrap_or(0)
+            .min(WIDEST);
+        let ws = rows
+            .iter()
+            .map(|r| r.1.len())
+            .max()
+            .unwrap_or(0)
+            .min(WIDEST);
         let mut s = String::from(
             "\noutputs computed only when read (a step that nobody reads them after costs nothing \
              more); `shape_points` sets the points, 0 none:\n",
