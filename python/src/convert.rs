@@ -9,14 +9,20 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 /// (TOML has no null: the field takes its default); anything that is no number, string,
 /// Boolean, list or mapping (numpy arrays and scalars go through their `tolist()`) is refused
 /// naming its path.
-pub fn to_toml(obj: &Bound<'_, PyAny>, path: &str, origin: &str) -> Result<toml::Value, Refusal> {
-    let refuse = |rule: String| Refusal {
-        message: format!("{origin}: field `{path}`: {rule}"),
-        origin: origin.to_string(),
-        field: Some(path.to_string()),
-        value: obj.repr().ok().map(|r| r.to_string()),
-        rule: Some(rule),
-        code: None,
+pub fn to_toml(
+    obj: &Bound<'_, PyAny>,
+    path: &str,
+    origin: &str,
+) -> Result<toml::Value, Box<Refusal>> {
+    let refuse = |rule: String| {
+        Box::new(Refusal {
+            message: format!("{origin}: field `{path}`: {rule}"),
+            origin: origin.to_string(),
+            field: Some(path.to_string()),
+            value: obj.repr().ok().map(|r| r.to_string()),
+            rule: Some(rule),
+            code: None,
+        })
     };
     if let Ok(b) = obj.cast::<PyBool>() {
         return Ok(toml::Value::Boolean(b.is_true()));
@@ -46,14 +52,14 @@ pub fn to_toml(obj: &Bound<'_, PyAny>, path: &str, origin: &str) -> Result<toml:
             let item = item.map_err(|e| refuse(e.to_string()))?;
             let at = format!("{path}[{i}]");
             if item.is_none() {
-                return Err(Refusal {
+                return Err(Box::new(Refusal {
                     message: format!("{origin}: field `{at}`: None in a list"),
                     origin: origin.to_string(),
                     field: Some(at),
                     value: Some("None".into()),
                     rule: Some("None in a list".into()),
                     code: None,
-                });
+                }));
             }
             items.push(to_toml(&item, &at, origin)?);
         }
@@ -85,13 +91,15 @@ pub fn to_toml(obj: &Bound<'_, PyAny>, path: &str, origin: &str) -> Result<toml:
 }
 
 /// The (key, value) pairs of a mapping as a TOML table; keys must be strings.
-fn table(items: &Bound<'_, PyAny>, path: &str, origin: &str) -> Result<toml::Table, Refusal> {
-    let fail = |field: String, rule: String| Refusal {
-        message: format!("{origin}: field `{field}`: {rule}"),
-        origin: origin.to_string(),
-        field: Some(field),
-        rule: Some(rule),
-        ..Refusal::default()
+fn table(items: &Bound<'_, PyAny>, path: &str, origin: &str) -> Result<toml::Table, Box<Refusal>> {
+    let fail = |field: String, rule: String| {
+        Box::new(Refusal {
+            message: format!("{origin}: field `{field}`: {rule}"),
+            origin: origin.to_string(),
+            field: Some(field),
+            rule: Some(rule),
+            ..Refusal::default()
+        })
     };
     let mut out = toml::Table::new();
     let iter = items

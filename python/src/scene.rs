@@ -66,7 +66,7 @@ impl PyScene {
         directory: Option<PathBuf>,
     ) -> PyResult<PyScene> {
         guard(|| {
-            let value = convert::to_toml(d, "", origin).map_err(|r| r.into_err(py))?;
+            let value = convert::to_toml(d, "", origin).map_err(|r| (*r).into_err(py))?;
             let toml::Value::Table(mut table) = value else {
                 return Err(Refusal {
                     message: format!("{origin}: a scene is a dict of its tables and keys"),
@@ -77,7 +77,7 @@ impl PyScene {
                 .into_err(py));
             };
             read_matrix_files(&mut table, directory.as_deref(), origin)
-                .map_err(|r| r.into_err(py))?;
+                .map_err(|r| (*r).into_err(py))?;
             let scene = Scene::from_toml_str(&toml_text(&table), origin)
                 .map_err(|e| refusal_in_dict(&e, &table).into_err(py))?;
             Ok(PyScene {
@@ -278,7 +278,7 @@ fn read_matrix_files(
     table: &mut toml::Table,
     directory: Option<&Path>,
     origin: &str,
-) -> Result<(), Refusal> {
+) -> Result<(), Box<Refusal>> {
     let Some(toml::Value::Array(beams)) = table.get_mut("beam") else {
         return Ok(());
     };
@@ -296,14 +296,14 @@ fn read_matrix_files(
         let text = std::fs::read_to_string(&path).map_err(|e| {
             let field = format!("beam[{i}].matrix_file");
             let rule = format!("cannot read {}: {e}", path.display());
-            Refusal {
+            Box::new(Refusal {
                 message: format!("{origin}: field `{field}` = {file:?}: {rule}"),
                 origin: origin.to_string(),
                 field: Some(field),
                 value: Some(format!("{file:?}")),
                 rule: Some(rule),
                 code: None,
-            }
+            })
         })?;
         b.insert("matrix_text".into(), toml::Value::String(text));
     }
