@@ -124,11 +124,10 @@ impl Model {
         let scene = Scene::from_toml_str(&scene.to_toml_string(), &origin)?;
         let sys = Mechanics::build(&scene, &resolve(&scene).effects);
         let settings = Settings::from_scene(&scene);
-        let start =
-            initial_state(&sys, &scene, 0.0, &settings).map_err(|source| BenchError::Engine {
-                origin: origin.clone(),
-                source,
-            })?;
+        let start = initial_state(&sys, 0.0, &settings).map_err(|source| BenchError::Engine {
+            origin: origin.clone(),
+            source,
+        })?;
         Ok(Model {
             sys,
             start,
@@ -189,9 +188,7 @@ impl Lu<'_> {
     fn factorize(&mut self) {
         let (m, s) = (self.model, &self.model.start);
         let w = iteration_scaling(m.settings.rho_inf, m.settings.max_step);
-        let ok = self
-            .matrix
-            .factorize(&m.sys, &s.q, &s.v, &s.qdd, &s.lambda, s.t, w);
+        let ok = self.matrix.factorize(&m.sys, &s.point(), w);
         assert!(ok, "the iteration matrix at the initial state is singular");
     }
 

@@ -83,6 +83,23 @@ pub enum EngineError {
         tolerance: f64,
     },
     #[error(
+        "doStep: {attempts} internal steps tried between t = {t_start} s and t = {t} s without \
+         reaching t = {t_end} s: the work budget of one communication step (documented in \
+         docs/robustness.md) is spent; the last good state is kept (a shorter communication \
+         step, or a scene whose forces and solver settings make sense, goes on)"
+    )]
+    /// One communication step took more internal steps than the work budget allows.
+    WorkBudget {
+        /// Where the communication step started (s).
+        t_start: f64,
+        /// Where the integrator was when the budget ran out (s).
+        t: f64,
+        /// Where the communication step was to end (s).
+        t_end: f64,
+        /// Internal steps tried (accepted and refused).
+        attempts: u64,
+    },
+    #[error(
         "beam '{beam}': deflection {deflection:.3e} m of a floating frame exceeds the frame's \
          length {length} m at t = {t} s: the solution has run away (a linear frame spun near or \
          above its first bending frequency softens without bound); use (more) substructures or \
@@ -203,6 +220,7 @@ impl EngineError {
                 | EngineError::SingularMatrix { .. }
                 | EngineError::NonFinite { .. }
                 | EngineError::StepTooSmall { .. }
+                | EngineError::WorkBudget { .. }
                 | EngineError::Runaway { .. }
                 | EngineError::Stretched { .. }
         )

@@ -207,7 +207,7 @@ fn auto_stays_within_each_case_tolerance_of_the_full_model() {
 fn integrate(scene: &Scene, effects: &Effects, stop: f64) -> System {
     let sys = System::build(scene, effects);
     let settings = Settings::from_scene(scene);
-    let mut st = initial_state(&sys, scene, 0.0, &settings).expect("initial state");
+    let mut st = initial_state(&sys, 0.0, &settings).expect("initial state");
     let mut stepper = Stepper::new(&sys, settings);
     let mut stats = Stats::default();
     stepper

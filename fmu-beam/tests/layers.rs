@@ -136,6 +136,39 @@ fn every_module_imports_only_from_its_layer_or_below() {
     );
 }
 
+/// The mechanics are built from their own types (issue 33): inside `mechanics/`, only the
+/// adapter `mechanics/from_scene/` names the scene format; the elements, the systems, their
+/// joints and laws take the mechanics' own `JointKind`, `DriveKind`, `TimeLaw`, `Section`.
+#[test]
+fn the_mechanics_read_the_scene_format_only_through_from_scene() {
+    let mechanics = src().join("mechanics");
+    let adapter = mechanics.join("from_scene");
+    let mut files = Vec::new();
+    rust_files(&mechanics, &mut files);
+    files.sort();
+    assert!(files.len() > 30, "only {} files in mechanics/", files.len());
+    let mut readers = Vec::new();
+    for file in files.iter().filter(|f| !f.starts_with(&adapter)) {
+        let text = std::fs::read_to_string(file).expect("readable");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if crate_paths(code).iter().any(|m| m == "scene") {
+                readers.push(format!(
+                    "{}:{}: {}",
+                    file.strip_prefix(src()).unwrap().display(),
+                    n + 1,
+                    line.trim()
+                ));
+            }
+        }
+    }
+    assert!(
+        readers.is_empty(),
+        "mechanics files that read the scene format (go through mechanics/from_scene/):\n{}",
+        readers.join("\n")
+    );
+}
+
 #[test]
 fn the_scan_sees_paths_groups_and_skips_other_crates() {
     assert_eq!(crate_paths("use crate::unit::engine::Engine;"), ["unit"]);

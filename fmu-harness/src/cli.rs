@@ -168,7 +168,8 @@ fn package_cmd(
     .map_err(stdout_err)
 }
 
-/// `simulate`: runs the FMU and writes its CSV to `csv` or `out`.
+/// `simulate`: runs the FMU and streams its CSV, row by row, to `csv` or `out`. A file is
+/// written as a temporary sibling (removed on an error or a signal) renamed at the end.
 fn simulate_cmd(
     fmu: &Path,
     stop: Option<f64>,
@@ -182,32 +183,66 @@ fn simulate_cmd(
         step,
         outputs,
     };
-    let text = simulate::simulate(fmu, &options)?.csv();
     match csv {
-        Some(path) => {
-            std::fs::write(path, text).map_err(|e| HarnessError::io(path, "writing the CSV", e))
+        Some(path) => write_csv_through_temporary(path, |sink| {
+            simulate::simulate_into(fmu, &options, sink).map_err(HarnessError::from)
+        }),
+        None => {
+            let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(out));
+            simulate::simulate_into(fmu, &options, &mut writer)?;
+            writer.into_inner().flush().map_err(stdout_err)
         }
-        None => out.write_all(text.as_bytes()).map_err(stdout_err),
     }
 }
 
-/// `cosim`: runs the system; the CSV goes to `csv` (summary to `out`) or to `out` (summary to
-/// standard error).
+/// `cosim`: runs the system; the CSV streams to `csv` (summary to `out`) or to `out` (summary
+/// to standard error), a file through a temporary sibling as in `simulate`.
 fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(), HarnessError> {
-    let (results, summary) = cosim::cosim(system)?;
     match csv {
         Some(path) => {
-            std::fs::write(path, results.csv())
-                .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+            let summary = write_csv_through_temporary(path, |sink| {
+                cosim::cosim_into(system, sink).map_err(HarnessError::from)
+            })?;
             writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)
         }
         None => {
-            out.write_all(results.csv().as_bytes())
-                .map_err(stdout_err)?;
+            let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(&mut *out));
+            let summary = cosim::cosim_into(system, &mut writer)?;
+            writer.into_inner().flush().map_err(stdout_err)?;
             eprint!("{}", summary.text());
             Ok(())
         }
     }
+}
+
+/// Runs `run` with a CSV writer on a new temporary sibling of `path` (registered, so that it
+/// goes on an error or a signal), then moves it to `path`.
+fn write_csv_through_temporary<T>(
+    path: &Path,
+    run: impl FnOnce(&mut dyn simulate::RowSink) -> Result<T, HarnessError>,
+) -> Result<T, HarnessError> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| HarnessError::BadOutput {
+            path: path.to_path_buf(),
+        })?
+        .to_string_lossy()
+        .into_owned();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let (scratch, file) = crate::scratch::Scratch::file(&tmp)
+        .map_err(|e| HarnessError::io(&tmp, "creating the CSV", e))?;
+    let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(file));
+    let value = run(&mut writer)?;
+    writer
+        .into_inner()
+        .into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(|f| f.sync_all())
+        .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
+    scratch
+        .persist(path)
+        .map_err(|e| HarnessError::io(path, "moving the CSV in place", e))?;
+    Ok(value)
 }
 
 /// The options of `animate`.

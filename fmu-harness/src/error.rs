@@ -73,8 +73,35 @@ pub enum HarnessError {
     Animate(#[from] crate::animate::AnimateError),
     #[error("{origin}: {message}")]
     Input { origin: String, message: String },
+    #[error(transparent)]
+    InputFile(#[from] crate::input_file::InputFileError),
+    #[error("{}: its symbol table cannot be read: {reason}", .path.display())]
+    LibrarySymbols { path: PathBuf, reason: String },
+    #[error(
+        "{}: {}",
+        .path.display(),
+        missing_functions_message(*.count, *.of, .missing)
+    )]
+    MissingFunctions {
+        path: PathBuf,
+        count: usize,
+        of: usize,
+        missing: Vec<&'static str>,
+    },
     #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
     BadOutput { path: PathBuf },
+}
+
+/// Which FMI 2.0 functions a `--binary` does not export.
+fn missing_functions_message(count: usize, of: usize, missing: &[&str]) -> String {
+    if count == of {
+        format!("exports none of the {of} FMI 2.0 co-simulation functions: not an FMU binary")
+    } else {
+        format!(
+            "does not export {count} of the {of} FMI 2.0 co-simulation functions: {}",
+            missing.join(", ")
+        )
+    }
 }
 
 /// Why a `--binary` cannot go under its platform's folder.

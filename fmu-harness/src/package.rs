@@ -6,6 +6,7 @@
 //! `resources/guid.txt` (checked there against fmuGUID) and `documentation/index.html`.
 
 use crate::archive::{self, Entry};
+use crate::engine_library;
 use crate::error::HarnessError;
 use crate::guid::guid;
 use crate::model_description;
@@ -191,7 +192,9 @@ fn canonical_text(scene: &Scene) -> Result<String, HarnessError> {
 /// Loads the scene, builds the FMU with one engine library per platform (without `binaries`,
 /// the Linux engine of [`default_binary`]) and writes it to `output` (atomically). Each
 /// library's platform is read from its header; one named in `binaries` must agree with it, and
-/// a platform may come only once.
+/// a platform may come only once. A library is read only if it is a regular file of at most
+/// [`engine_library::MAX_LIBRARY_BYTES`], and kept only if it exports every FMI 2.0
+/// co-simulation function ([`engine_library::check_exports`]).
 pub fn package(
     scene_path: &Path,
     output: &Path,
@@ -216,8 +219,7 @@ pub fn package_scene(
     };
     let mut libraries: Vec<(Platform, PathBuf, Vec<u8>)> = Vec::new();
     for arg in given {
-        let bytes = std::fs::read(&arg.path)
-            .map_err(|e| HarnessError::io(&arg.path, "reading the engine library", e))?;
+        let bytes = engine_library::read(&arg.path)?;
         let found = Platform::of_library(&bytes);
         let platform = match (arg.platform, found) {
             (Some(named), Some(found)) if named == found => found,
@@ -230,6 +232,7 @@ pub fn package_scene(
                 })
             }
         };
+        engine_library::check_exports(&arg.path, &bytes, platform)?;
         if let Some((_, first, _)) = libraries.iter().find(|(p, _, _)| *p == platform) {
             return Err(HarnessError::DuplicatePlatform {
                 platform,

@@ -2,6 +2,8 @@
 //! `binaries/<platform>/<modelIdentifier>.<extension>`), and the platform of an engine library
 //! read from its header, so that a library is never packaged under the wrong folder.
 
+mod stand_in;
+
 use std::fmt;
 
 /// A platform folder of FMI 2.0 that the packager fills.
@@ -83,27 +85,17 @@ impl fmt::Display for Platform {
     }
 }
 
-/// The first bytes of a library of `platform` as [`Platform::of_library`] reads them, padded
-/// to `len` bytes (at least 0x200): for tests that package stand-in engines.
+/// A stand-in library of `platform`: a header [`Platform::of_library`] recognizes and a symbol
+/// table that exports every FMI 2.0 co-simulation function (the packager checks both), padded
+/// to `len` bytes (it has at least 0x200): for tests that package stand-in engines.
 pub fn library_header(platform: Platform, len: usize) -> Vec<u8> {
-    let mut b = vec![0u8; len.max(0x200)];
-    match platform {
-        Platform::Linux64 => {
-            b[..4].copy_from_slice(b"\x7fELF");
-            b[4] = 2;
-            b[5] = 1;
-            b[16] = 3;
-            b[18] = 62;
-        }
-        Platform::Win64 => {
-            let pe = 0x80;
-            b[..2].copy_from_slice(b"MZ");
-            b[0x3c] = pe as u8;
-            b[pe..pe + 4].copy_from_slice(b"PE\0\0");
-            b[pe + 4..pe + 6].copy_from_slice(&0x8664u16.to_le_bytes());
-            b[pe + 22..pe + 24].copy_from_slice(&0x2022u16.to_le_bytes());
-            b[pe + 24..pe + 26].copy_from_slice(&0x20bu16.to_le_bytes());
-        }
+    let names = &crate::engine_library::FMI2_COSIMULATION_FUNCTIONS;
+    let mut b = match platform {
+        Platform::Linux64 => stand_in::elf(names),
+        Platform::Win64 => stand_in::pe(names),
+    };
+    if b.len() < len {
+        b.resize(len, 0);
     }
     b
 }
@@ -143,5 +135,20 @@ mod tests {
             None
         );
         assert_eq!(Platform::from_folder("darwin64"), None);
+    }
+
+    #[test]
+    fn missing_exports_are_named_for_either_platform() {
+        use crate::engine_library::missing_functions;
+        let few = ["fmi2Instantiate", "fmi2DoStep"];
+        for (p, bytes) in [
+            (Platform::Linux64, stand_in::elf(&few)),
+            (Platform::Win64, stand_in::pe(&few)),
+        ] {
+            assert_eq!(Platform::of_library(&bytes), Some(p));
+            let missing = missing_functions(&bytes, p).unwrap();
+            assert_eq!(missing.len(), 32);
+            assert!(missing.contains(&"fmi2GetReal") && !missing.contains(&"fmi2DoStep"));
+        }
     }
 }

@@ -5,9 +5,25 @@
 //! `fmi2SetupExperiment(tolerance of DefaultExperiment if any, start, stop)`, communication points
 //! start + (n+1)·h, the last step shortened to land on the stop time, the run ends when t is
 //! within 1e-9 relative of the stop time.
+//!
+//! Rows go to a [`RowSink`] as they are recorded: the command line streams them to the CSV
+//! ([`CsvWriter`]), so a long run holds one row in memory, not all of them; [`simulate`] keeps
+//! them ([`Results`]). A run is refused before it starts when it would take more than
+//! [`MAX_COMMUNICATION_STEPS`] steps (a `stepSize="1e-300"` of a hostile FMU).
 
 use crate::slave::{Slave, SlaveError, VarType, Variable};
+use std::io::Write;
 use std::path::Path;
+
+/// Communication steps of one run: 1e8 (a day at 1 ms is 8.6e7). More is refused as absurd
+/// before the FMU is instantiated.
+pub const MAX_COMMUNICATION_STEPS: f64 = 1e8;
+
+/// Where recorded rows go, one at a time: first the columns, then each row (time first).
+pub trait RowSink {
+    fn columns(&mut self, names: &[String], types: &[VarType]) -> std::io::Result<()>;
+    fn row(&mut self, row: &[f64]) -> std::io::Result<()>;
+}
 
 /// What to run; `None` takes the model description's DefaultExperiment.
 #[derive(Debug, Clone, Default)]
@@ -29,29 +45,83 @@ pub struct Results {
 
 impl Results {
     /// CSV: a header `time,<names>`, then one line per communication point, reals in shortest
-    /// round-trip form.
+    /// round-trip form (the same bytes [`CsvWriter`] streams).
     pub fn csv(&self) -> String {
-        let mut s = String::from("time");
-        for c in &self.columns {
-            s.push(',');
-            s.push_str(c);
-        }
-        s.push('\n');
+        let mut w = CsvWriter::new(Vec::new());
+        // Writing to a Vec cannot fail.
+        let _ = w.columns(&self.columns, &self.types);
         for row in &self.rows {
-            for (i, v) in row.iter().enumerate() {
-                if i > 0 {
-                    s.push(',');
-                }
-                match i.checked_sub(1).map(|k| self.types[k]) {
-                    Some(VarType::Integer | VarType::Boolean | VarType::Enumeration) => {
-                        s.push_str(&format!("{}", *v as i64))
-                    }
-                    _ => s.push_str(&format!("{v:e}")),
-                }
-            }
-            s.push('\n');
+            let _ = w.row(row);
         }
-        s
+        String::from_utf8_lossy(&w.into_inner()).into_owned()
+    }
+}
+
+impl RowSink for Results {
+    fn columns(&mut self, names: &[String], types: &[VarType]) -> std::io::Result<()> {
+        self.columns = names.to_vec();
+        self.types = types.to_vec();
+        Ok(())
+    }
+
+    fn row(&mut self, row: &[f64]) -> std::io::Result<()> {
+        self.rows.push(row.to_vec());
+        Ok(())
+    }
+}
+
+/// Writes rows as CSV while they come: the header `time,<names>`, then one line per row, reals
+/// in shortest round-trip form (`{:e}`), Integer, Boolean and Enumeration as integers.
+pub struct CsvWriter<W: Write> {
+    out: W,
+    types: Vec<VarType>,
+    line: String,
+}
+
+impl<W: Write> CsvWriter<W> {
+    pub fn new(out: W) -> Self {
+        CsvWriter {
+            out,
+            types: Vec::new(),
+            line: String::new(),
+        }
+    }
+
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+}
+
+impl<W: Write> RowSink for CsvWriter<W> {
+    fn columns(&mut self, names: &[String], types: &[VarType]) -> std::io::Result<()> {
+        self.types = types.to_vec();
+        self.line.clear();
+        self.line.push_str("time");
+        for c in names {
+            self.line.push(',');
+            self.line.push_str(c);
+        }
+        self.line.push('\n');
+        self.out.write_all(self.line.as_bytes())
+    }
+
+    fn row(&mut self, row: &[f64]) -> std::io::Result<()> {
+        use std::fmt::Write as _;
+        self.line.clear();
+        for (i, v) in row.iter().enumerate() {
+            if i > 0 {
+                self.line.push(',');
+            }
+            // Writing to a String cannot fail.
+            let _ = match i.checked_sub(1).and_then(|k| self.types.get(k)) {
+                Some(VarType::Integer | VarType::Boolean | VarType::Enumeration) => {
+                    write!(self.line, "{}", *v as i64)
+                }
+                _ => write!(self.line, "{v:e}"),
+            };
+        }
+        self.line.push('\n');
+        self.out.write_all(self.line.as_bytes())
     }
 }
 
@@ -86,10 +156,39 @@ pub enum SimulateError {
         "bad experiment: start {start}, stop {stop}, step {step} (need stop > start, step > 0)"
     )]
     BadExperiment { start: f64, stop: f64, step: f64 },
+    #[error(
+        "step {step:e} from {start} to {stop} is {steps:.3e} communication steps; the master \
+         takes at most {limit:e} (give a larger --step)"
+    )]
+    TooManySteps {
+        start: f64,
+        stop: f64,
+        step: f64,
+        steps: f64,
+        limit: f64,
+    },
+    #[error("writing the results: {0}")]
+    Output(#[source] std::io::Error),
 }
 
-/// Runs the FMU from start to stop with communication step `step`.
+/// Runs the FMU from start to stop with communication step `step`, keeping every row.
 pub fn simulate(fmu: &Path, options: &Options) -> Result<Results, SimulateError> {
+    let mut results = Results {
+        columns: Vec::new(),
+        types: Vec::new(),
+        rows: Vec::new(),
+    };
+    simulate_into(fmu, options, &mut results)?;
+    Ok(results)
+}
+
+/// Runs the FMU from start to stop with communication step `step`, each row to `sink` as soon
+/// as it is recorded.
+pub fn simulate_into(
+    fmu: &Path,
+    options: &Options,
+    sink: &mut dyn RowSink,
+) -> Result<(), SimulateError> {
     let mut slave = Slave::load(fmu)?;
     let md = slave.model_description.clone();
     let de = md.default_experiment;
@@ -101,6 +200,16 @@ pub fn simulate(fmu: &Path, options: &Options) -> Result<Results, SimulateError>
         .unwrap_or((stop - start) / 500.0);
     if !(stop > start && step > 0.0 && step.is_finite() && stop.is_finite()) {
         return Err(SimulateError::BadExperiment { start, stop, step });
+    }
+    let steps = ((stop - start) / step).ceil();
+    if steps.is_nan() || steps > MAX_COMMUNICATION_STEPS {
+        return Err(SimulateError::TooManySteps {
+            start,
+            stop,
+            step,
+            steps,
+            limit: MAX_COMMUNICATION_STEPS,
+        });
     }
     let vars: Vec<Variable> = if options.outputs.is_empty() {
         md.outputs().cloned().collect()
@@ -121,7 +230,12 @@ pub fn simulate(fmu: &Path, options: &Options) -> Result<Results, SimulateError>
     slave.setup_experiment(de.tolerance, start, Some(stop))?;
     slave.enter_initialization_mode()?;
     slave.exit_initialization_mode()?;
-    let mut rows = vec![record(&mut slave, start, &vars)?];
+    let names: Vec<String> = vars.iter().map(|v| v.name.clone()).collect();
+    let types: Vec<VarType> = vars.iter().map(|v| v.var_type).collect();
+    sink.columns(&names, &types)
+        .map_err(SimulateError::Output)?;
+    sink.row(&record(&mut slave, start, &vars)?)
+        .map_err(SimulateError::Output)?;
     let mut t = start;
     let mut n: u64 = 0;
     while !(t > stop || is_close(t, stop)) {
@@ -132,12 +246,9 @@ pub fn simulate(fmu: &Path, options: &Options) -> Result<Results, SimulateError>
         slave.do_step(t, next - t, true)?;
         t = next;
         n += 1;
-        rows.push(record(&mut slave, t, &vars)?);
+        sink.row(&record(&mut slave, t, &vars)?)
+            .map_err(SimulateError::Output)?;
     }
     slave.terminate()?;
-    Ok(Results {
-        columns: vars.iter().map(|v| v.name.clone()).collect(),
-        types: vars.iter().map(|v| v.var_type).collect(),
-        rows,
-    })
+    Ok(())
 }

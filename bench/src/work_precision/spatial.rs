@@ -21,14 +21,14 @@ use crate::error::BenchError;
 use fmu_beam::integrator::{initial_state, GaState, Settings, Stats, Stepper};
 use fmu_beam::mechanics::matrix_file_beam;
 use fmu_beam::mechanics::Drive;
+use fmu_beam::mechanics::DriveKind;
 use fmu_beam::mechanics::FloatingFrame;
 use fmu_beam::mechanics::SpatialSection;
 use fmu_beam::mechanics::{spatial_element_mass, spatial_element_stiffness};
-use fmu_beam::mechanics::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
+use fmu_beam::mechanics::{Body3, Frame3, JointKind, Load3, RigidBody3, System3};
 use fmu_beam::mechanics::{InertiaModel, SpatialBeam, SpatialBeamProps};
 use fmu_beam::mechanics::{Law, TimeLaw};
 use fmu_beam::scene::matrix_file::{self, MatrixFile};
-use fmu_beam::scene::DriveKind;
 use fmu_beam::{EngineError, Scene};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use std::f64::consts::PI;
@@ -331,13 +331,12 @@ fn unwrap(prev: f64, x: f64) -> f64 {
 /// at every communication point.
 fn integrate(
     sys: &System3,
-    scene: &Scene,
     settings: Settings,
     comm: f64,
     stop: f64,
     mut record: impl FnMut(&GaState),
 ) -> Result<Stats, EngineError> {
-    let mut st = initial_state(sys, scene, 0.0, &settings)?;
+    let mut st = initial_state(sys, 0.0, &settings)?;
     let mut stepper = Stepper::new(sys, settings);
     let mut stats = Stats::default();
     record(&st);
@@ -374,7 +373,7 @@ fn measured(
 /// C5 in `k` substructures of one element: [[mid-span point's distance from the exact one /
 /// L], [tip distance from the root / L], [tip rotation about z (rad)]], means over the last
 /// C5_WINDOW.
-fn c5(scene: &Scene, k: usize, setting: Setting) -> Result<Series, EngineError> {
+fn c5(k: usize, setting: Setting) -> Result<Series, EngineError> {
     measured(|| {
         let beam = props(C5_LENGTH, 1, InertiaModel::Full, C5_ALPHA);
         let mut sys = System3::new(None);
@@ -382,7 +381,7 @@ fn c5(scene: &Scene, k: usize, setting: Setting) -> Result<Series, EngineError> 
         let g = sys.add_beam("beam", &beam, k, Vector3::zeros(), id);
         let fw = sys.world_frame(Vector3::zeros(), id);
         let fa = sys.beam_frame(g, false, id);
-        sys.add_joint("clamp", JointKind3::Weld, fw, fa, None);
+        sys.add_joint("clamp", JointKind::Weld, fw, fa, None);
         let tip = sys.beam_frame(g, true, id);
         sys.add_load(Load3 {
             name: "moment".into(),
@@ -405,23 +404,16 @@ fn c5(scene: &Scene, k: usize, setting: Setting) -> Result<Series, EngineError> 
         let exact_mid = Vector3::new(0.0, C5_LENGTH / PI, 0.0);
         let (mut angle, mut n, mut mean, mut rot, mut off) =
             (0.0, 0usize, Vector3::zeros(), 0.0, Vector3::zeros());
-        let stats = integrate(
-            &sys,
-            scene,
-            integrator(setting, C5_COMM),
-            C5_COMM,
-            C5_STOP,
-            |st| {
-                let (x, a) = sys.beam_tip(g, &st.q);
-                angle = unwrap(angle, a[(1, 0)].atan2(a[(0, 0)]));
-                if st.t > C5_STOP - C5_WINDOW - 1e-9 {
-                    mean += x;
-                    rot += angle;
-                    off += mid.pose(Some(sys.body_coords(body, &st.q))).0 - exact_mid;
-                    n += 1;
-                }
-            },
-        )?;
+        let stats = integrate(&sys, integrator(setting, C5_COMM), C5_COMM, C5_STOP, |st| {
+            let (x, a) = sys.beam_tip(g, &st.q);
+            angle = unwrap(angle, a[(1, 0)].atan2(a[(0, 0)]));
+            if st.t > C5_STOP - C5_WINDOW - 1e-9 {
+                mean += x;
+                rot += angle;
+                off += mid.pose(Some(sys.body_coords(body, &st.q))).0 - exact_mid;
+                n += 1;
+            }
+        })?;
         let n = n as f64;
         Ok((
             vec![
@@ -435,32 +427,25 @@ fn c5(scene: &Scene, k: usize, setting: Setting) -> Result<Series, EngineError> 
 }
 
 /// C6 with `model`: [[hinge angle (unwrapped) at every communication point]].
-fn c6(scene: &Scene, model: Model, setting: Setting) -> Result<Series, EngineError> {
+fn c6(model: Model, setting: Setting) -> Result<Series, EngineError> {
     measured(|| {
         let mut sys = System3::new(Some(Vector3::new(0.0, 0.0, -9.81)));
         // joint axes: z along world y (x0 = X, y0 = −Z)
         let axes = Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0);
         let fw = sys.world_frame(Vector3::zeros(), axes);
         let (_, f1) = add_model(&mut sys, model, C6_LENGTH, axes);
-        let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, f1, None);
+        let hinge = sys.add_joint("hinge", JointKind::Revolute, fw, f1, None);
         let mut angles = Vec::new();
-        let stats = integrate(
-            &sys,
-            scene,
-            integrator(setting, C6_COMM),
-            C6_COMM,
-            C6_STOP,
-            |st| {
-                let a = sys.joint_coordinate(hinge, &st.q);
-                angles.push(angles.last().map_or(a, |&p| unwrap(p, a)));
-            },
-        )?;
+        let stats = integrate(&sys, integrator(setting, C6_COMM), C6_COMM, C6_STOP, |st| {
+            let a = sys.joint_coordinate(hinge, &st.q);
+            angles.push(angles.last().map_or(a, |&p| unwrap(p, a)));
+        })?;
         Ok((vec![angles], stats))
     })
 }
 
 /// The spin-up with `model`: [[tip deflection in the root frame, in the plane of rotation]].
-fn spin_up(scene: &Scene, model: Model, setting: Setting) -> Result<Series, EngineError> {
+fn spin_up(model: Model, setting: Setting) -> Result<Series, EngineError> {
     measured(|| {
         let mut sys = System3::new(None);
         let id = Matrix3::identity();
@@ -477,11 +462,10 @@ fn spin_up(scene: &Scene, model: Model, setting: Setting) -> Result<Series, Engi
                 until: None,
             },
         };
-        sys.add_joint("hub", JointKind3::Revolute, fw, fa, Some(drive));
+        sys.add_joint("hub", JointKind::Revolute, fw, fa, Some(drive));
         let mut tip = Vec::new();
         let stats = integrate(
             &sys,
-            scene,
             integrator(setting, SPIN_COMM),
             SPIN_COMM,
             SPIN_STOP,
@@ -707,13 +691,6 @@ pub fn study(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Results, BenchError> {
     let started = Instant::now();
-    // System3 places itself; `initial_state` takes a scene it does not read.
-    let scene = Scene::from_toml_str(
-        "name = \"spatial\"\n[[beam]]\nname = \"beam\"\nlength = 1.0\nelements = 1\n\
-         material = { rho = 7800.0, E = 210e9 }\nsection = { A = 1e-3, J = 1e-8 }\n",
-        "3D bench placeholder",
-    )?;
-    let scene = &scene;
     let mut tick = |text: &str| {
         let el = started.elapsed().as_secs();
         progress(&format!("[3D, {:>2}:{:02}] {text}", el / 60, el % 60));
@@ -743,9 +720,7 @@ pub fn study(
                         setting.mode(),
                         options.budget
                     ));
-                } else if let Some(s) =
-                    take(&mut p, timed(&|| c5(scene, k, setting), options.repeats))
-                {
+                } else if let Some(s) = take(&mut p, timed(&|| c5(k, setting), options.repeats)) {
                     let (m, d, rot) = (s.values[0][0], s.values[1][0], s.values[2][0]);
                     let e = (rot - 2.0 * PI).abs();
                     p.errors = vec![m * C5_LENGTH, d * C5_LENGTH, e];
@@ -798,7 +773,7 @@ pub fn study(
                 inertia: InertiaModel::Full,
             },
         };
-        let r = c6(scene, model(n_ref), s_ref)
+        let r = c6(model(n_ref), s_ref)
             .map_err(engine(format!("C6 reference run ({})", c6_name(n_ref))))?;
         let reference = r.values[0].clone();
         let last = reference[reference.len() - 1];
@@ -807,7 +782,7 @@ pub fn study(
             Setting::FixedStep(h) => Setting::FixedStep(h / 2.0),
             Setting::Tolerance(t) => Setting::Tolerance(t / 10.0),
         };
-        let check = c6(scene, model(n_ref), finer)
+        let check = c6(model(n_ref), finer)
             .map_err(engine(format!("C6 reference check ({})", c6_name(n_ref))))?;
         let moved = (check.values[0][check.values[0].len() - 1] - last).abs();
         let described = format!(
@@ -834,10 +809,9 @@ pub fn study(
                         setting.mode(),
                         options.budget
                     ));
-                } else if let Some(s) = take(
-                    &mut p,
-                    timed(&|| c6(scene, model(n), setting), options.repeats),
-                ) {
+                } else if let Some(s) =
+                    take(&mut p, timed(&|| c6(model(n), setting), options.repeats))
+                {
                     score_series(&mut p, s, &reference);
                     if p.seconds[0] > options.budget {
                         over.push(setting.mode());
@@ -860,7 +834,7 @@ pub fn study(
             })
             .collect();
         for k in C6_ELEMENTS {
-            let r = c6(scene, model(k), s_ref).map_err(engine(format!(
+            let r = c6(model(k), s_ref).map_err(engine(format!(
                 "C6 at the reference setting ({})",
                 c6_name(k)
             )))?;
@@ -952,9 +926,9 @@ pub fn study(
                 .iter()
                 .map(|&(_, m)| -> Box<Run> {
                     if i == 0 {
-                        Box::new(move || c6(scene, m, setting))
+                        Box::new(move || c6(m, setting))
                     } else {
-                        Box::new(move || spin_up(scene, m, setting))
+                        Box::new(move || spin_up(m, setting))
                     }
                 })
                 .collect();

@@ -20,6 +20,7 @@ use super::types::{
 };
 use crate::error::EngineError;
 use crate::unit::engine::Engine;
+use crate::unit::variables::VarType;
 
 pub struct Instance {
     pub(super) logger: Logger,
@@ -191,19 +192,20 @@ impl Instance {
     }
 
     pub fn set_integer(&mut self, vr: &[u32], value: &[i32]) -> Result<(), Fault> {
-        for (&r, &v) in vr.iter().zip(value) {
-            self.engine.set_integer(r, v).map_err(|e| self.fail(e))?;
-        }
-        Ok(())
+        let value: Vec<f64> = value.iter().map(|&v| v as f64).collect();
+        self.engine
+            .set_many(vr, VarType::Integer, &value)
+            .map_err(|e| self.fail(e))
     }
 
     pub fn set_boolean(&mut self, vr: &[u32], value: &[fmi2Boolean]) -> Result<(), Fault> {
-        for (&r, &v) in vr.iter().zip(value) {
-            self.engine
-                .set_boolean(r, v != fmi2False)
-                .map_err(|e| self.fail(e))?;
-        }
-        Ok(())
+        let value: Vec<f64> = value
+            .iter()
+            .map(|&v| if v != fmi2False { 1.0 } else { 0.0 })
+            .collect();
+        self.engine
+            .set_many(vr, VarType::Boolean, &value)
+            .map_err(|e| self.fail(e))
     }
 
     /// fmi2GetString / fmi2SetString: this FMU has no String variables.
@@ -236,9 +238,8 @@ impl Instance {
 
     pub fn set_fmu_state(&mut self, s: &FmuState) -> Result<(), Fault> {
         if let Err(e) = self.engine.restore(s.snapshot()) {
-            self.state = ModelState::Error;
             return Err(Fault::refused(format!(
-                "{e}; the instance is now in state Error"
+                "{e}; the instance is left as it was"
             )));
         }
         self.transition(s.model_state());
@@ -326,11 +327,8 @@ impl Instance {
         order: &[i32],
         value: &[f64],
     ) -> Result<(), Fault> {
-        for ((&r, &k), &v) in vr.iter().zip(order).zip(value) {
-            self.engine
-                .set_input_derivative(r, k, v)
-                .map_err(|e| self.fail(e))?;
-        }
-        Ok(())
+        self.engine
+            .set_input_derivatives(vr, order, value)
+            .map_err(|e| self.fail(e))
     }
 }

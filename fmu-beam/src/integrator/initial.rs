@@ -4,21 +4,19 @@
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::{GaState, Settings};
 use crate::error::EngineError;
-use crate::mechanics::multibody::Equations;
-use crate::scene::Scene;
+use crate::mechanics::multibody::{Equations, Point};
 use nalgebra::{DMatrix, DVector};
 
 const ASSEMBLY_ITERATIONS: usize = 50;
 
-/// Builds the state at `t0` from the scene's initial configuration.
+/// Builds the state at `t0` from the system's initial configuration.
 pub fn initial_state<S: Equations + ?Sized>(
     sys: &S,
-    scene: &Scene,
     t0: f64,
     settings: &Settings,
 ) -> Result<GaState, EngineError> {
     let (n, m) = (sys.n(), sys.m());
-    let mut q = sys.initial_coordinates(scene)?;
+    let mut q = sys.initial_coordinates()?;
     let v = DVector::zeros(n);
     let tol = 1e-12 * sys.length_scale().max(1.0);
     let mut g = DVector::zeros(m);
@@ -146,7 +144,14 @@ pub fn consistent_accelerations<S: Equations + ?Sized>(
     x.rows_mut(n, m).copy_from(&(-bias));
     let mut matrix = IterationMatrix::new(sys, LinearSolver::Auto);
     let (zero_n, zero_m) = (DVector::zeros(n), DVector::zeros(m));
-    let solved = matrix.factorize(sys, q, v, &zero_n, &zero_m, t, w)
+    let at = Point {
+        q,
+        v,
+        a: &zero_n,
+        lambda: &zero_m,
+        t,
+    };
+    let solved = matrix.factorize(sys, &at, w)
         && matrix.solve_mut(&mut x)
         && x.iter().all(|v| v.is_finite());
     if !solved {
@@ -215,7 +220,11 @@ pub fn meet_jump<S: Equations + ?Sized>(
         x[n + k] = -(after.bias[k] - before.bias[k]);
     }
     let mut matrix = IterationMatrix::new(sys, LinearSolver::Auto);
-    let solved = matrix.factorize(sys, &st.q, &st.v, &st.qdd, &st.lambda, t_after, w)
+    let at = Point {
+        t: t_after,
+        ..st.point()
+    };
+    let solved = matrix.factorize(sys, &at, w)
         && matrix.solve_mut(&mut x)
         && x.iter().all(|v| v.is_finite());
     if !solved {

@@ -6,7 +6,7 @@
 //! [`LinearSolver::Auto`] chooses from the system's size by [`prefers_sparse`], a rule read off
 //! the measurements of `fmu-harness linear-solvers` (docs/linear_algebra.md).
 
-use crate::mechanics::multibody::{BlockDiagonal, Equations, JacobianRows};
+use crate::mechanics::multibody::{BlockDiagonal, Equations, JacobianRows, Point};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
@@ -148,25 +148,16 @@ impl IterationMatrix {
         }
     }
 
-    /// Evaluates the matrix at (q, q', q'', λ, t) and factorizes it; false when singular.
-    #[allow(clippy::too_many_arguments)]
-    pub fn factorize<S: Equations + ?Sized>(
-        &mut self,
-        sys: &S,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        qdd: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        w: Scaling,
-    ) -> bool {
+    /// Evaluates the matrix at a point (q, q', q'', λ, t) and factorizes it; false when
+    /// singular.
+    pub fn factorize<S: Equations + ?Sized>(&mut self, sys: &S, at: &Point, w: Scaling) -> bool {
         self.factored = false;
         let with_tangents = w.d != 0.0 || w.cc != 0.0;
-        sys.mass_blocks(q, &mut self.mass);
+        sys.mass_blocks(at.q, &mut self.mass);
         if with_tangents {
-            sys.tangent_blocks(q, v, qdd, lambda, t, &mut self.kt, &mut self.ct);
+            sys.tangent_blocks(at, &mut self.kt, &mut self.ct);
         }
-        sys.jacobian_rows(q, t, &mut self.rows);
+        sys.jacobian_rows(at.q, at.t, &mut self.rows);
         let block = |kt: &DMatrix<f64>, mm: &DMatrix<f64>, ct: &DMatrix<f64>, i, j| {
             if with_tangents {
                 kt[(i, j)] * w.d + mm[(i, j)] * w.cm + ct[(i, j)] * w.cc

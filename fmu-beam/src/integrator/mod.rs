@@ -17,6 +17,7 @@ pub(crate) use iteration_matrix::Scaling;
 pub use iteration_matrix::{IterationMatrix, LinearSolver};
 
 use crate::error::EngineError;
+use crate::mechanics::multibody::Point;
 use crate::scene::Scene;
 pub(crate) use codec::{write_vec, Reader};
 
@@ -87,6 +88,17 @@ impl Stats {
 }
 
 impl GaState {
+    /// The state as a point of the equations: (q, q', q'', λ) at its time.
+    pub fn point(&self) -> Point<'_> {
+        Point {
+            q: &self.q,
+            v: &self.v,
+            a: &self.qdd,
+            lambda: &self.lambda,
+            t: self.t,
+        }
+    }
+
     pub(crate) fn write(&self, w: &mut Vec<u8>) {
         w.extend_from_slice(&self.t.to_le_bytes());
         w.extend_from_slice(&self.h.to_le_bytes());

@@ -1,24 +1,22 @@
 //! The equations an engine runs: the planar [`System`] (planar scenes, and 3D scenes whose
-//! motion reduces to the plane, [`Scene::planar_reduction`]) or the spatial [`System3`]. One
+//! motion reduces to the plane) or the spatial [`System3`] (built in `from_scene/`). One
 //! [`Equations`] implementation over both, so the integrator and the engine see one type.
 
-use super::Effects;
 use crate::error::EngineError;
-use crate::mechanics::multibody::equations::{CoordinateKind, Equations, Turning};
+use crate::mechanics::from_scene::SceneIndex;
+use crate::mechanics::multibody::equations::{CoordinateKind, Equations, Point, Turning};
 use crate::mechanics::multibody::law::InputValue;
 use crate::mechanics::multibody::sparsity::{BlockDiagonal, JacobianRows};
 use crate::mechanics::multibody::System;
-use crate::mechanics::multibody3d::build::{self, SceneIndex};
 use crate::mechanics::multibody3d::System3;
-use crate::scene::Scene;
 use nalgebra::DVector;
 use std::ops::Range;
 
 /// The system a scene builds, planar or spatial, as one [`Equations`].
 #[derive(Debug, Clone)]
 pub enum Mechanics {
-    /// The planar system, with the planar scene it was built from.
-    Planar(System, Box<Scene>),
+    /// The planar system.
+    Planar(System),
     /// The spatial system, with where the scene's parts are in it.
     Spatial(System3, SceneIndex),
 }
@@ -27,27 +25,13 @@ pub enum Mechanics {
 macro_rules! each {
     ($m:expr, $s:ident => $e:expr) => {
         match $m {
-            Mechanics::Planar($s, _) => $e,
+            Mechanics::Planar($s) => $e,
             Mechanics::Spatial($s, _) => $e,
         }
     };
 }
 
 impl Mechanics {
-    /// The system of a validated scene computing `effects` (resolved from the same scene).
-    pub fn build(scene: &Scene, effects: &Effects) -> Mechanics {
-        match scene.planar_reduction() {
-            Ok(planar) => {
-                let sys = System::build(&planar, effects);
-                Mechanics::Planar(sys, Box::new(planar))
-            }
-            Err(_) => {
-                let (sys, index) = build::from_scene(scene, effects);
-                Mechanics::Spatial(sys, index)
-            }
-        }
-    }
-
     /// The FMU inputs as the system holds them, by input slot.
     pub fn inputs(&self) -> &[InputValue] {
         each!(self, s => &s.inputs)
@@ -75,12 +59,8 @@ impl Equations for Mechanics {
     fn frame_coordinates(&self) -> Vec<usize> {
         each!(self, s => Equations::frame_coordinates(s))
     }
-    /// The planar system places its bodies from the planar scene it was built from.
-    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
-        match self {
-            Mechanics::Planar(s, planar) => Equations::initial_coordinates(s, planar),
-            Mechanics::Spatial(s, _) => Equations::initial_coordinates(s, scene),
-        }
+    fn initial_coordinates(&self) -> Result<DVector<f64>, EngineError> {
+        each!(self, s => Equations::initial_coordinates(s))
     }
     fn body_ranges(&self) -> Vec<Range<usize>> {
         each!(self, s => Equations::body_ranges(s))
@@ -101,17 +81,8 @@ impl Equations for Mechanics {
     ) {
         each!(self, s => Equations::body_residual(s, q, v, a, t, r))
     }
-    fn tangent_blocks(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        kt: &mut BlockDiagonal,
-        ct: &mut BlockDiagonal,
-    ) {
-        each!(self, s => Equations::tangent_blocks(s, q, v, a, lambda, t, kt, ct))
+    fn tangent_blocks(&self, at: &Point, kt: &mut BlockDiagonal, ct: &mut BlockDiagonal) {
+        each!(self, s => Equations::tangent_blocks(s, at, kt, ct))
     }
     fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>) {
         each!(self, s => Equations::constraints(s, q, t, g))

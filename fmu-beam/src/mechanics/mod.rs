@@ -1,6 +1,7 @@
 //! Layer 2, the mechanics: beam sections and finite elements (planar and spatial), the planar
 //! and spatial multibody systems with their joints, and the [`Equations`] the integrator solves.
-//! Imports only the scene format and the errors below it.
+//! Imports only the errors; the systems, joints and laws have their own types, and the scene
+//! format is read in one place, `from_scene/` (the one door, checked by `tests/layers.rs`).
 //!
 //! Public here: what assembles a system without a scene file (the benchmarks build C5's beam
 //! this way); the element internals stay private to the crate.
@@ -21,9 +22,9 @@ pub use beam::spatial_element::{
 };
 pub use beam::spatial_section::SpatialSection;
 pub use beam::FloatingFrame;
-pub use multibody::joint::Drive;
+pub use from_scene::matrix_file_beam;
+pub use multibody::joint::{Drive, DriveKind, JointKind};
 pub use multibody::law::{Law, TimeLaw};
-pub use multibody::{Equations, System};
-pub use multibody3d::build::matrix_file_beam;
-pub use multibody3d::{Body3, Frame3, JointKind3, Load3, RigidBody3, System3};
+pub use multibody::{Equations, Point, System};
+pub use multibody3d::{Body3, Frame3, Load3, RigidBody3, System3};
 pub use options::{BeamEffects, Effects};

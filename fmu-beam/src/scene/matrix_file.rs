@@ -1,6 +1,6 @@
 //! A beam whose mass and stiffness come from 12 × 12 matrices in a text file, condensed from
 //! another FE tool (3D paper §6): the file's format, its parser with errors that name file,
-//! line and rule (the beam it gives: `multibody3d::build::matrix_file_beam`).
+//! line and rule (the beam it gives: `from_scene::matrix_file_beam`).
 //!
 //! # Format
 //! ```text

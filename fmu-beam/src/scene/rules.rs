@@ -222,6 +222,14 @@ pub(crate) const MIN_STEP: Rule = rule(
     Any,
     Schema::AtLeast(super::validate::MIN_STEP),
 );
+/// Its text quotes [`super::validate::MAX_STEP`] (a test checks it).
+pub(crate) const MAX_STEP: Rule = rule(
+    "max_step",
+    &["solver.max_step"],
+    "must be at most 1 s (a longer step resolves no motion of a flexible multibody scene)",
+    Any,
+    Schema::AtMost(super::validate::MAX_STEP),
+);
 pub(crate) const RHO_INF: Rule = rule(
     "rho_inf",
     &["solver.rho_inf"],
@@ -771,6 +779,7 @@ pub const RULES: &[Rule] = &[
     IN_PLANE,
     TOLERANCE_BELOW_ONE,
     MIN_STEP,
+    MAX_STEP,
     RHO_INF,
     STOP_AFTER_START,
     A_BEAM,

@@ -45,7 +45,8 @@ use crate::mechanics::beam::spatial_element::{NODE_DOFS, TZ, U, V};
 use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::multibody::joint::Drive;
 use crate::mechanics::multibody::law::TimeLaw;
-use crate::mechanics::multibody3d::{Body3, Frame3, JointKind3, RigidBody3, System3};
+use crate::mechanics::multibody3d::{Body3, Frame3, RigidBody3, System3};
+use crate::mechanics::JointKind;
 use crate::scene::{BeamSpec, Scene};
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 use std::time::Instant;
@@ -129,7 +130,7 @@ fn spatial(
 ) -> Series {
     let settings = grid.settings(scene);
     // (System3 places its bodies itself; the scene is not read)
-    let mut st = initial_state(sys, scene, 0.0, &settings).expect("assembles");
+    let mut st = initial_state(sys, 0.0, &settings).expect("assembles");
     let mut stepper = Stepper::new(sys, settings);
     let mut stats = Stats::default();
     let mut rows = vec![record(&st.q)];
@@ -222,7 +223,7 @@ fn drive(scene: &Scene, joint: &str) -> Option<Drive> {
         .find(|j| j.name == joint)
         .expect("joint");
     spec.drive.as_ref().map(|d| Drive {
-        kind: d.kind,
+        kind: d.kind.into(),
         law: TimeLaw::from_spec(&d.law, None),
     })
 }
@@ -349,7 +350,7 @@ fn c1_3d(scene: &Scene, grid: Grid) -> Series {
     let g = add_beam(&mut sys, &scene.beams[0]);
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
-    sys.add_joint("clamp", JointKind3::Weld, fw, fa, None);
+    sys.add_joint("clamp", JointKind::Weld, fw, fa, None);
     spatial(&sys, scene, grid, |q| tip_outputs(&sys, g, q).to_vec())
 }
 
@@ -362,7 +363,7 @@ fn c2_3d(scene: &Scene, grid: Grid) -> Series {
     let g = add_beam(&mut sys, &scene.beams[0]);
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
-    let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, fa, None);
+    let hinge = sys.add_joint("hinge", JointKind::Revolute, fw, fa, None);
     spatial(&sys, scene, grid, |q| {
         let mut r = vec![sys.joint_coordinate(hinge, q)];
         r.extend(tip_outputs(&sys, g, q));
@@ -403,14 +404,14 @@ fn c3_3d(scene: &Scene, grid: Grid) -> Series {
     let block_o = sys.rigid_frame(block, "origin");
     let pivot = sys.add_joint(
         "crank_pivot",
-        JointKind3::Revolute,
+        JointKind::Revolute,
         fw,
         crank_a,
         drive(scene, "crank_pivot"),
     );
-    sys.add_joint("crank_rod", JointKind3::Spherical, crank_b, rod_a, None);
-    sys.add_joint("rod_block", JointKind3::Spherical, rod_b, block_o, None);
-    let slider = sys.add_joint("slider", JointKind3::Prismatic, fw, block_o, None);
+    sys.add_joint("crank_rod", JointKind::Spherical, crank_b, rod_a, None);
+    sys.add_joint("rod_block", JointKind::Spherical, rod_b, block_o, None);
+    let slider = sys.add_joint("slider", JointKind::Prismatic, fw, block_o, None);
     // the rod's mid-span point, as the planar `System::beam_mid`
     let body = sys.beams[rod].bodies.start;
     let Body3::Beam(b) = &sys.bodies[body] else {
@@ -440,7 +441,7 @@ fn c4_3d(scene: &Scene, grid: Grid) -> Series {
     let g = add_beam(&mut sys, &scene.beams[0]);
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
-    let hub = sys.add_joint("hub", JointKind3::Revolute, fw, fa, drive(scene, "hub"));
+    let hub = sys.add_joint("hub", JointKind::Revolute, fw, fa, drive(scene, "hub"));
     spatial(&sys, scene, grid, |q| {
         let mut r = vec![sys.joint_coordinate(hub, q)];
         r.extend(tip_outputs(&sys, g, q));

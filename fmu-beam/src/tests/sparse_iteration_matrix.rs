@@ -31,7 +31,7 @@ fn substructured(file: &str, k: usize, step: f64) -> Scene {
 fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
     let sys = Mechanics::build(s, &resolve(s).effects);
     let settings = Settings::from_scene(s);
-    let st = initial_state(&sys, s, 0.0, &settings).expect("assembles");
+    let st = initial_state(&sys, 0.0, &settings).expect("assembles");
     (sys, st, settings)
 }
 
@@ -45,7 +45,7 @@ fn dense_matrix(sys: &Mechanics, st: &GaState, h: f64, rho_inf: f64) -> DMatrix<
     );
     let mut g = DMatrix::zeros(m, n);
     sys.mass_matrix(&st.q, &mut mm);
-    sys.tangents(&st.q, &st.v, &st.qdd, &st.lambda, st.t, &mut kt, &mut ct);
+    sys.tangents(&st.point(), &mut kt, &mut ct);
     sys.constraint_jacobian(&st.q, st.t, &mut g);
     let w = iteration_scaling(rho_inf, h);
     let mut a = DMatrix::zeros(n + m, n + m);
@@ -66,7 +66,7 @@ fn solves_like_the_dense_matrices(s: &Scene) {
     for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
         let mut matrix = IterationMatrix::new(&sys, linear);
         assert_eq!(matrix.is_sparse(), linear == LinearSolver::Sparse);
-        assert!(matrix.factorize(&sys, &st.q, &st.v, &st.qdd, &st.lambda, st.t, w));
+        assert!(matrix.factorize(&sys, &st.point(), w));
         let mut x = b.clone();
         assert!(matrix.solve_mut(&mut x));
         let residual = (&a * &x - &b).amax() / b.amax();
@@ -344,7 +344,7 @@ fn the_error_filter_weighs_each_mode_as_the_step_resolves_it() {
     ];
     for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
         let mut matrix = IterationMatrix::new(&sys, linear);
-        assert!(matrix.factorize(&sys, &st.q, &st.v, &st.qdd, &st.lambda, st.t, w));
+        assert!(matrix.factorize(&sys, &st.point(), w));
         let mut rhs = DVector::zeros(n + m);
         for &i in &picks {
             let omega = eig.eigenvalues[i].max(0.0).sqrt();

@@ -16,7 +16,7 @@ use crate::mechanics::beam::spatial_beam::{
 };
 use crate::mechanics::beam::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
 use crate::mechanics::beam::spatial_section::SpatialSection;
-use crate::mechanics::multibody3d::build::matrix_file_beam;
+use crate::mechanics::from_scene::matrix_file_beam;
 use crate::mechanics::FloatingFrame;
 use crate::scene::matrix_file::{self, MatrixFile, MatrixFileError};
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector2, Vector3};

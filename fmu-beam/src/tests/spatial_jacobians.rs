@@ -8,9 +8,10 @@ use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::multibody::joint::Drive;
 use crate::mechanics::multibody::law::{Law, TimeLaw};
 use crate::mechanics::multibody::Equations;
-use crate::mechanics::multibody3d::{JointKind3, Load3, RigidBody3, System3};
+use crate::mechanics::multibody3d::{Load3, RigidBody3, System3};
+use crate::mechanics::DriveKind;
 use crate::mechanics::FloatingFrame;
-use crate::scene::DriveKind;
+use crate::mechanics::JointKind;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
 /// A small deterministic generator (xorshift) of numbers in [−1, 1].
@@ -84,14 +85,14 @@ fn system(rng: &mut Random) -> System3 {
         rng.rotation(),
     );
     let kinds = [
-        (JointKind3::Weld, None),
-        (JointKind3::Revolute, None),
-        (JointKind3::Revolute, drive(DriveKind::Motion)),
-        (JointKind3::Revolute, drive(DriveKind::Effort)),
-        (JointKind3::Prismatic, None),
-        (JointKind3::Prismatic, drive(DriveKind::Motion)),
-        (JointKind3::Prismatic, drive(DriveKind::Effort)),
-        (JointKind3::Spherical, None),
+        (JointKind::Weld, None),
+        (JointKind::Revolute, None),
+        (JointKind::Revolute, drive(DriveKind::Motion)),
+        (JointKind::Revolute, drive(DriveKind::Effort)),
+        (JointKind::Prismatic, None),
+        (JointKind::Prismatic, drive(DriveKind::Motion)),
+        (JointKind::Prismatic, drive(DriveKind::Effort)),
+        (JointKind::Spherical, None),
     ];
     for (i, (kind, dr)) in kinds.into_iter().enumerate() {
         let f0 = match i % 3 {
@@ -119,8 +120,7 @@ fn system(rng: &mut Random) -> System3 {
 /// A random state: frames moved and turned, quaternions off the unit sphere, beams deformed
 /// (section rotations up to about 0.3 rad).
 fn state(sys: &System3, rng: &mut Random) -> DVector<f64> {
-    let scene = super::common::scene("flexible_pendulum.toml"); // not read by System3
-    let mut q = sys.initial_coordinates(&scene).expect("placement");
+    let mut q = sys.initial_coordinates().expect("placement");
     for i in 0..sys.bodies.len() {
         let o = sys.offsets[i];
         for k in 0..sys.bodies[i].ncoords() {
@@ -170,7 +170,7 @@ fn joint_rates_match_central_differences_of_the_joint_coordinate() {
         let q = state(&sys, &mut rng);
         let v = DVector::from_fn(sys.n(), |_, _| rng.next());
         for (j, jt) in sys.joints.iter().enumerate() {
-            if !matches!(jt.kind, JointKind3::Revolute | JointKind3::Prismatic) {
+            if !matches!(jt.kind, JointKind::Revolute | JointKind::Prismatic) {
                 continue;
             }
             let rate = sys.joint_rate(j, &q, &v);

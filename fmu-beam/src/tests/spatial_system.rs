@@ -8,8 +8,9 @@ use crate::integrator::{initial_state, GaState, Settings, Stats, Stepper};
 use crate::mechanics::beam::spatial_beam::{InertiaModel, SpatialBeamProps};
 use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::multibody3d::quaternion::{g_body, rotation};
-use crate::mechanics::multibody3d::{JointKind3, RigidBody3, System3};
+use crate::mechanics::multibody3d::{RigidBody3, System3};
 use crate::mechanics::FloatingFrame;
+use crate::mechanics::JointKind;
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 fn fixed(h: f64) -> Settings {
@@ -31,8 +32,7 @@ fn simulate(
     stop: f64,
     mut record: impl FnMut(&GaState),
 ) -> GaState {
-    let scene = super::common::scene("flexible_pendulum.toml"); // not read by System3
-    let mut st = initial_state(sys, &scene, 0.0, &settings).expect("assembles");
+    let mut st = initial_state(sys, 0.0, &settings).expect("assembles");
     let mut stepper = Stepper::new(sys, settings);
     let mut stats = Stats::default();
     record(&st);
@@ -101,7 +101,7 @@ fn rigid_pendulum_on_a_spherical_joint_keeps_its_quaternion_and_energy() {
     );
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fb = sys.rigid_frame(body, "pivot");
-    sys.add_joint("ball", JointKind3::Spherical, fw, fb, None);
+    sys.add_joint("ball", JointKind::Spherical, fw, fb, None);
     let (mut e0, mut drift, mut norm, mut swing) = (None, 0.0f64, 0.0f64, 0.0f64);
     let stop = 3.0;
     simulate(&sys, fixed(1e-3), 1e-2, stop, |st| {
@@ -150,7 +150,7 @@ fn c2_3d(h: f64) -> Vec<(f64, f64)> {
     let g = sys.add_beam("beam", &props, 1, Vector3::zeros(), Matrix3::identity());
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
-    let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, fa, None);
+    let hinge = sys.add_joint("hinge", JointKind::Revolute, fw, fa, None);
     let mut out: Vec<(f64, f64)> = Vec::new();
     simulate(&sys, fixed(h), 1e-2, 1.0, |st| {
         let a = sys.joint_coordinate(hinge, &st.q);
@@ -266,7 +266,7 @@ fn c6(elements: Option<usize>, settings: Settings, hc: f64) -> Vec<f64> {
             sys.rigid_frame(b, "a")
         }
     };
-    let hinge = sys.add_joint("hinge", JointKind3::Revolute, fw, f1, None);
+    let hinge = sys.add_joint("hinge", JointKind::Revolute, fw, f1, None);
     let mut angles = Vec::new();
     let mut angle = 0.0;
     simulate(&sys, settings, hc, 1.0, |st| {
@@ -386,7 +386,7 @@ fn c5(k: usize, axis: usize) -> (f64, f64) {
     let g = sys.add_beam("beam", &props, k, Vector3::zeros(), Matrix3::identity());
     let fw = sys.world_frame(Vector3::zeros(), Matrix3::identity());
     let fa = sys.beam_frame(g, false, Matrix3::identity());
-    sys.add_joint("clamp", JointKind3::Weld, fw, fa, None);
+    sys.add_joint("clamp", JointKind::Weld, fw, fa, None);
     let tip = sys.beam_frame(g, true, Matrix3::identity());
     let mut torque = Vector3::zeros();
     torque[axis] = 2.0 * std::f64::consts::PI * ei;

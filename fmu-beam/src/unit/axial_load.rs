@@ -46,7 +46,7 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
         max_step: dt,
         rho_inf: scene.solver.rho_inf,
     };
-    let mut st = initial_state(&sys, &rigid, t0, &settings).map_err(|e| e.to_string())?;
+    let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
     let mut stepper = Stepper::new(&sys, settings);
     let mut stats = Stats::default();
     let mut gm = DMatrix::zeros(sys.m(), sys.n());

@@ -177,7 +177,7 @@ pub fn dependencies(scene: &Scene, vars: &[Variable]) -> Vec<Vec<u32>> {
         /// A motion input's acceleration: acts on the accelerations as a force does.
         MotionAcceleration,
     }
-    let slots = crate::mechanics::multibody::system::input_slots(scene);
+    let slots = crate::mechanics::from_scene::input_slots(scene);
     let mut inputs: Vec<(u32, Vec<usize>, Acts)> = Vec::new();
     for v in vars {
         let (slot, order) = match v.binding {
@@ -309,11 +309,11 @@ pub fn inputs_jump(ended: &[f64], next: &[f64], sys: &Mechanics) -> bool {
 fn motion_slots(sys: &Mechanics) -> Vec<bool> {
     let mut motion = vec![false; sys.inputs().len()];
     let drives: Vec<&crate::mechanics::multibody::joint::Drive> = match sys {
-        Mechanics::Planar(s, _) => s.joints.iter().filter_map(|j| j.drive.as_ref()).collect(),
+        Mechanics::Planar(s) => s.joints.iter().filter_map(|j| j.drive.as_ref()).collect(),
         Mechanics::Spatial(s, _) => s.joints.iter().filter_map(|j| j.drive.as_ref()).collect(),
     };
     for d in drives {
-        if let (DriveKind::Motion, Law::Input(slot)) = (d.kind, &d.law.law) {
+        if let (crate::mechanics::DriveKind::Motion, Law::Input(slot)) = (d.kind, &d.law.law) {
             if let Some(m) = motion.get_mut(*slot) {
                 *m = true;
             }

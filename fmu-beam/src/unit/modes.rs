@@ -3,7 +3,7 @@
 
 use crate::error::EngineError;
 use crate::integrator::{initial_state, Settings};
-use crate::mechanics::multibody::equations::Equations;
+use crate::mechanics::multibody::equations::{Equations, Point};
 use crate::mechanics::Mechanics;
 use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector};
@@ -28,8 +28,8 @@ pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
     };
     let effects = crate::unit::effects::resolve(scene).effects;
     let sys = Mechanics::build(scene, &effects);
-    let st = initial_state(&sys, scene, 0.0, &settings)?;
-    let q = Mechanics::build(&undeformed, &effects).initial_coordinates(&undeformed)?;
+    let st = initial_state(&sys, 0.0, &settings)?;
+    let q = Mechanics::build(&undeformed, &effects).initial_coordinates()?;
     linearized(&sys, &q, &st.lambda)
 }
 
@@ -46,7 +46,14 @@ fn linearized<E: Equations>(
     let mut ct = DMatrix::zeros(n, n);
     let mut gm = DMatrix::zeros(m, n);
     sys.mass_matrix(q, &mut mm);
-    sys.tangents(q, &zero, &zero, lambda, 0.0, &mut kt, &mut ct);
+    let at = Point {
+        q,
+        v: &zero,
+        a: &zero,
+        lambda,
+        t: 0.0,
+    };
+    sys.tangents(&at, &mut kt, &mut ct);
     sys.constraint_jacobian(q, 0.0, &mut gm);
     let basis = null_space(&gm, n);
     let mr = basis.transpose() * &mm * &basis;

@@ -56,7 +56,7 @@ impl ShapeMaps {
             (first + i, (x - i as f64 * part).clamp(0.0, part))
         };
         match system {
-            Mechanics::Planar(sys, _) => ShapeMaps::Planar(
+            Mechanics::Planar(sys) => ShapeMaps::Planar(
                 scene
                     .beams
                     .iter()
@@ -117,7 +117,7 @@ impl ShapeMaps {
     /// planar system's z is 0).
     pub fn point(&self, system: &Mechanics, q: &DVector<f64>, g: usize, k: usize) -> [f64; 3] {
         match (self, system) {
-            (ShapeMaps::Planar(maps), Mechanics::Planar(sys, _)) => {
+            (ShapeMaps::Planar(maps), Mechanics::Planar(sys)) => {
                 let (body, map) = &maps[g][k];
                 let p = sys.bodies[*body].point(map, sys.body_coords(*body, q)).0;
                 [p[0], p[1], 0.0]
@@ -139,7 +139,7 @@ impl ShapeMaps {
 /// root frame's axis (the chord to flange b for a planar pinned frame).
 pub fn axis(system: &Mechanics, q: &DVector<f64>, g: usize) -> [f64; 3] {
     match system {
-        Mechanics::Planar(sys, _) => {
+        Mechanics::Planar(sys) => {
             let a = sys.beam_axis(g, q).1;
             [a[0], a[1], 0.0]
         }

@@ -35,11 +35,14 @@ impl Recording {
     }
 }
 
+/// Bytes of a run's CSV that `animate` reads: 1 GiB.
+pub const MAX_CSV_BYTES: u64 = 1024 * 1024 * 1024;
+
 /// A CSV with a header of names (quoted or not) and rows of numbers, such as `simulate`,
-/// `cosim` and fmpy write.
+/// `cosim` and fmpy write; a regular file of at most [`MAX_CSV_BYTES`], and errors say where,
+/// without quoting the file.
 pub fn read_csv(path: &Path) -> Result<Recording, HarnessError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| HarnessError::io(path, "reading the run's CSV", e))?;
+    let text = crate::input_file::read_text(path, "a run's CSV", MAX_CSV_BYTES)?;
     let mut lines = text
         .lines()
         .enumerate()
@@ -58,7 +61,7 @@ pub fn read_csv(path: &Path) -> Result<Recording, HarnessError> {
     if columns.first().map(String::as_str) != Some("time") {
         return Err(AnimateError::Csv {
             path: path.into(),
-            message: format!("the first column must be `time`, not {:?}", columns.first()),
+            message: "the first column must be `time`".into(),
         }
         .into());
     }
@@ -73,11 +76,11 @@ pub fn read_csv(path: &Path) -> Result<Recording, HarnessError> {
             }
             .into());
         }
-        for (c, f) in values.iter_mut().zip(fields) {
+        for (i, (c, f)) in values.iter_mut().zip(fields).enumerate() {
             let v = f.trim().parse::<f64>().map_err(|_| AnimateError::CsvLine {
                 path: path.into(),
                 line: k + 1,
-                message: format!("{f:?} is not a number"),
+                message: format!("field {} is not a number", i + 1),
             })?;
             c.push(v);
         }
@@ -116,11 +119,26 @@ pub fn packaged_scene(path: &Path) -> Result<Option<Scene>, HarnessError> {
     let Ok(mut entry) = zip.by_name("resources/scene.toml") else {
         return Ok(None);
     };
+    let origin = format!("{}!resources/scene.toml", path.display());
+    let refuse = |message: String| HarnessError::Input {
+        origin: origin.clone(),
+        message,
+    };
+    // The FMU is untrusted, as in `Slave::load`: no link, and no more than it may expand to.
+    if entry.is_symlink() {
+        return Err(refuse("a symbolic link: the master refuses it".into()));
+    }
+    let limit = crate::slave::MAX_EXTRACTED_BYTES;
     let mut text = String::new();
-    entry
+    (&mut entry)
+        .take(limit + 1)
         .read_to_string(&mut text)
         .map_err(|e| HarnessError::io(path, "reading resources/scene.toml", e))?;
-    let origin = format!("{}!resources/scene.toml", path.display());
+    if text.len() as u64 > limit {
+        return Err(refuse(format!(
+            "more than {limit} bytes: the master extracts at most that"
+        )));
+    }
     Ok(Some(Scene::from_toml_str(&text, &origin)?))
 }
 

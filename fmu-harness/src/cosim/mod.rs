@@ -39,7 +39,7 @@ pub mod system;
 pub use results::Summary;
 
 use crate::fmi2_binding::FmuState;
-use crate::simulate::Results;
+use crate::simulate::{Results, RowSink, MAX_COMMUNICATION_STEPS};
 use crate::slave::{Slave, SlaveError};
 use extrapolation::History;
 use joint::Joints;
@@ -98,6 +98,13 @@ pub enum CosimError {
         max: u32,
         reason: String,
     },
+    #[error(
+        "at t = {t}: {steps} communication steps taken; the master takes at most {limit:e} \
+         (raise step.variable.min)"
+    )]
+    TooManySteps { t: f64, steps: u64, limit: f64 },
+    #[error("writing the results: {0}")]
+    Output(#[source] std::io::Error),
 }
 
 /// One unit: its slave and what the master knows of it.
@@ -166,10 +173,33 @@ pub fn cosim(path: &Path) -> Result<(Results, Summary), CosimError> {
     run(&system, path)
 }
 
+/// Runs the system file, each recorded row to `sink`; returns the summary.
+pub fn cosim_into(path: &Path, sink: &mut dyn RowSink) -> Result<Summary, CosimError> {
+    let system = System::load(path)?;
+    run_into(&system, path, sink)
+}
+
 /// Runs a checked system; `path` locates the FMUs (relative to its directory) and names errors.
-/// Set up (`setup.rs`), then communication steps (`step_control.rs`) to the stop time, the
-/// outputs recorded at every grid point (fixed step) or every step (variable).
+/// Returns every recorded row and the summary.
 pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimError> {
+    let mut results = Results {
+        columns: Vec::new(),
+        types: Vec::new(),
+        rows: Vec::new(),
+    };
+    let summary = run_into(system, path, &mut results)?;
+    Ok((results, summary))
+}
+
+/// Runs a checked system, each recorded row to `sink` as soon as it is read. Set up
+/// (`setup.rs`), then communication steps (`step_control.rs`) to the stop time, the outputs
+/// recorded at every grid point (fixed step) or every step (variable). A fixed step is bounded
+/// to [`MAX_COMMUNICATION_STEPS`] by the system file's check; a variable step here, as it goes.
+pub fn run_into(
+    system: &System,
+    path: &Path,
+    sink: &mut dyn RowSink,
+) -> Result<Summary, CosimError> {
     // joints retry refused steps with half the step even without [rollback]
     let implied = RollbackSpec::default();
     let rollback = system
@@ -185,7 +215,11 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
     setup::start_values(&mut units, &mut links, t0)?;
     let joints = setup::joints(system, path, &mut units, t0)?;
 
-    let mut rows = vec![results::record(&mut units, &recorded, t0)?];
+    let names: Vec<String> = recorded.iter().map(|r| r.2.clone()).collect();
+    let types: Vec<_> = recorded.iter().map(|r| r.1.var_type).collect();
+    sink.columns(&names, &types).map_err(CosimError::Output)?;
+    sink.row(&results::record(&mut units, &recorded, t0)?)
+        .map_err(CosimError::Output)?;
     let mut master = Master {
         system,
         rollback,
@@ -212,6 +246,13 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
     let mut grid: u64 = 0; // fixed step: index of the last grid point reached
     let mut h = system.step.size;
     while !(t > stop || is_close(t, stop)) {
+        if master.summary.accepted_steps as f64 >= MAX_COMMUNICATION_STEPS {
+            return Err(CosimError::TooManySteps {
+                t,
+                steps: master.summary.accepted_steps,
+                limit: MAX_COMMUNICATION_STEPS,
+            });
+        }
         let target = step_end(system, t, h, grid);
         let mut h_try = target - t;
         if !variable_step {
@@ -226,19 +267,13 @@ pub fn run(system: &System, path: &Path) -> Result<(Results, Summary), CosimErro
         h = step.next_h;
         master.accept(t, &step)?;
         if variable_step || t == target {
-            rows.push(results::record(&mut master.units, &recorded, t)?);
+            sink.row(&results::record(&mut master.units, &recorded, t)?)
+                .map_err(CosimError::Output)?;
         }
     }
     let mut summary = master.terminate()?;
     summary.stop_time = t;
-    Ok((
-        Results {
-            columns: recorded.iter().map(|r| r.2.clone()).collect(),
-            types: recorded.iter().map(|r| r.1.var_type).collect(),
-            rows,
-        },
-        summary,
-    ))
+    Ok(summary)
 }
 
 /// The end of the step from `t`: the next grid point after the `grid`-th (fixed step) or t + h

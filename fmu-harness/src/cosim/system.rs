@@ -13,8 +13,8 @@ use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum SystemError {
-    #[error("{}: {message}", .path.display())]
-    Read { path: PathBuf, message: String },
+    #[error(transparent)]
+    File(#[from] crate::input_file::InputFileError),
     #[error("{}: {message}", .path.display())]
     Parse { path: PathBuf, message: String },
     #[error("{}: field `{field}`: {message}", .path.display())]
@@ -23,6 +23,36 @@ pub enum SystemError {
         field: String,
         message: String,
     },
+}
+
+/// Bytes of a system file: 16 MiB.
+pub const MAX_SYSTEM_FILE_BYTES: u64 = 16 * 1024 * 1024;
+
+/// Where the TOML is wrong and why, without the source line toml's own message quotes, and
+/// without the value serde's `invalid type: string "…", expected …` quotes (only its kind is
+/// kept); the reason is cut at 200 characters.
+fn parse_message(text: &str, e: &toml::de::Error) -> String {
+    let message = e.message().trim_end();
+    let unquoted = ["invalid type: ", "invalid value: "]
+        .iter()
+        .find_map(|head| {
+            let rest = message.strip_prefix(head)?;
+            let (found, expected) = rest.split_once(", expected ")?;
+            let kind = found.split_whitespace().next().unwrap_or("value");
+            Some(format!("{head}{kind}, expected {expected}"))
+        })
+        .unwrap_or_else(|| message.to_string());
+    let mut why: String = unquoted.chars().take(200).collect();
+    if unquoted.chars().count() > 200 {
+        why.push('…');
+    }
+    match e.span() {
+        Some(span) => {
+            let (line, column) = crate::input_file::line_column(text, span.start);
+            format!("line {line}, column {column}: {why}")
+        }
+        None => why,
+    }
 }
 
 /// The whole system file.
@@ -304,10 +334,7 @@ pub fn split_name(full: &str) -> Option<(&str, &str)> {
 impl System {
     /// Reads, parses and checks a system file.
     pub fn load(path: &Path) -> Result<System, SystemError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SystemError::Read {
-            path: path.to_path_buf(),
-            message: format!("reading the system file: {e}"),
-        })?;
+        let text = crate::input_file::read_text(path, "a system file", MAX_SYSTEM_FILE_BYTES)?;
         System::from_toml_str(&text, path)
     }
 
@@ -315,7 +342,7 @@ impl System {
     pub fn from_toml_str(text: &str, path: &Path) -> Result<System, SystemError> {
         let system: System = toml::from_str(text).map_err(|e| SystemError::Parse {
             path: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
+            message: parse_message(text, &e),
         })?;
         system.check(path)?;
         Ok(system)
@@ -347,6 +374,18 @@ impl System {
             }
         };
         positive("step.size", self.step.size)?;
+        let steps = ((self.stop_time - self.start_time) / self.step.size).ceil();
+        let limit = crate::simulate::MAX_COMMUNICATION_STEPS;
+        if self.step.variable.is_none() && (steps.is_nan() || steps > limit) {
+            return Err(bad(
+                "step.size",
+                format!(
+                    "= {:e}: {steps:.3e} communication steps from start_time to stop_time; \
+                     the master takes at most {limit:e}",
+                    self.step.size
+                ),
+            ));
+        }
         if let Some(v) = &self.step.variable {
             positive("step.variable.min", v.min)?;
             positive("step.variable.max", v.max)?;

@@ -2,9 +2,63 @@
 //! model identifier, GUID, capability flags, scalar variables and default experiment (the file
 //! the packager writes is [`crate::model_description`]'s).
 
-use super::SlaveError;
+use super::extract::shown;
+use super::{FmuRefused, SlaveError};
+use crate::input_file::line_column;
 use quick_xml::events::{BytesStart, Event};
+use std::collections::HashMap;
 use std::path::Path;
+
+/// Bytes of a `modelIdentifier`: 251, so that `<modelIdentifier>.dll` fits a file name of 255
+/// bytes (NAME_MAX of Linux and most file systems).
+pub const MAX_MODEL_IDENTIFIER_BYTES: usize = 251;
+
+/// Why `id` cannot name a binary: it must be a C identifier ([A-Za-z_][A-Za-z0-9_]*, FMI 2.0
+/// §2.2.1 asks the C function prefix to be one) of at most [`MAX_MODEL_IDENTIFIER_BYTES`].
+fn identifier_problem(id: &str) -> Option<&'static str> {
+    let mut chars = id.chars();
+    match chars.next() {
+        None => Some("is empty"),
+        _ if id.len() > MAX_MODEL_IDENTIFIER_BYTES => Some("is too long"),
+        Some(c) if !(c.is_ascii_alphabetic() || c == '_') => {
+            Some("does not start with a letter or `_`")
+        }
+        _ if !chars.all(|c| c.is_ascii_alphanumeric() || c == '_') => {
+            Some("holds a character other than a letter, digit or `_`")
+        }
+        _ => None,
+    }
+}
+
+/// What the XML parser expected, in words of our own: the parser's own messages quote the
+/// document (a tag's name, an attribute's text), and the document is not to be echoed.
+fn expected(e: &quick_xml::Error) -> String {
+    use quick_xml::errors::{IllFormedError, SyntaxError};
+    use quick_xml::Error;
+    match e {
+        Error::Syntax(s) => match s {
+            SyntaxError::InvalidBangMarkup => "a comment, CDATA or DOCTYPE after `<!`".into(),
+            SyntaxError::UnclosedPIOrXmlDecl => "`?>` closing a declaration".into(),
+            SyntaxError::UnclosedComment => "`-->` closing a comment".into(),
+            SyntaxError::UnclosedDoctype => "`>` closing the DOCTYPE".into(),
+            SyntaxError::UnclosedCData => "`]]>` closing a CDATA section".into(),
+            SyntaxError::UnclosedTag => "`>` closing a tag".into(),
+        },
+        Error::IllFormed(f) => match f {
+            IllFormedError::MissingEndTag(name) => format!("an end tag `</{}>`", shown(name)),
+            IllFormedError::MismatchedEndTag { expected, .. } => {
+                format!("the end tag `</{}>`", shown(expected))
+            }
+            IllFormedError::UnmatchedEndTag(_) => "no end tag here (nothing is open)".into(),
+            IllFormedError::DoubleHyphenInComment => "no `--` inside a comment".into(),
+            _ => "a well-formed XML declaration or DOCTYPE".into(),
+        },
+        Error::InvalidAttr(_) => "attributes as name=\"value\", each name once".into(),
+        Error::Encoding(_) => "text in UTF-8".into(),
+        Error::Escape(_) => "a known entity or character reference after `&`".into(),
+        Error::Io(_) | Error::Namespace(_) => "well-formed XML".into(),
+    }
+}
 
 /// Base type of a scalar variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -76,9 +130,15 @@ impl ModelDescription {
         let mut pending: Option<(String, u32, Causality)> = None;
         let mut in_model_variables = false;
         loop {
-            let event = reader
-                .read_event()
-                .map_err(|e| fail(format!("at byte {}: {e}", reader.buffer_position())))?;
+            let event = reader.read_event().map_err(|e| {
+                let (line, column) = line_column(xml, reader.error_position() as usize);
+                SlaveError::from(FmuRefused::XmlSyntax {
+                    path: origin.to_path_buf(),
+                    line,
+                    column,
+                    expected: expected(&e),
+                })
+            })?;
             let (e, empty) = match &event {
                 Event::Start(e) => (e, false),
                 Event::Empty(e) => (e, true),
@@ -87,7 +147,10 @@ impl ModelDescription {
                         b"ModelVariables" => in_model_variables = false,
                         b"ScalarVariable" => {
                             if let Some((name, ..)) = pending.take() {
-                                return Err(fail(format!("variable `{name}` has no type element")));
+                                return Err(fail(format!(
+                                    "variable `{}` has no type element",
+                                    shown(&name)
+                                )));
                             }
                         }
                         _ => {}
@@ -103,8 +166,18 @@ impl ModelDescription {
                     md.guid = attr("guid")?.ok_or_else(|| fail("no guid".into()))?;
                 }
                 b"CoSimulation" => {
-                    md.model_identifier = attr("modelIdentifier")?
+                    let id = attr("modelIdentifier")?
                         .ok_or_else(|| fail("CoSimulation has no modelIdentifier".into()))?;
+                    if let Some(reason) = identifier_problem(&id) {
+                        return Err(SlaveError::from(FmuRefused::ModelIdentifier {
+                            path: origin.to_path_buf(),
+                            shown: shown(&id),
+                            bytes: id.len(),
+                            limit: MAX_MODEL_IDENTIFIER_BYTES,
+                            reason,
+                        }));
+                    }
+                    md.model_identifier = id;
                     md.can_get_and_set_fmu_state =
                         attr("canGetAndSetFMUstate")?.as_deref() == Some("true");
                     md.can_interpolate_inputs =
@@ -117,7 +190,7 @@ impl ModelDescription {
                         attr(key)?
                             .map(|v| {
                                 v.trim().parse::<f64>().map_err(|_| {
-                                    fail(format!("DefaultExperiment {key}=\"{v}\" is not a number"))
+                                    fail(format!("DefaultExperiment {key} is not a number"))
                                 })
                             })
                             .transpose()
@@ -135,7 +208,12 @@ impl ModelDescription {
                         attr("name")?.ok_or_else(|| fail("a variable has no name".into()))?;
                     let vr = attr("valueReference")?
                         .and_then(|v| v.trim().parse::<u32>().ok())
-                        .ok_or_else(|| fail(format!("variable `{name}`: bad valueReference")))?;
+                        .ok_or_else(|| {
+                            fail(format!(
+                                "variable `{}`: valueReference is not an integer in [0, 2^32)",
+                                shown(&name)
+                            ))
+                        })?;
                     let causality = match attr("causality")?.as_deref().unwrap_or("local") {
                         "parameter" => Causality::Parameter,
                         "calculatedParameter" => Causality::CalculatedParameter,
@@ -143,14 +221,19 @@ impl ModelDescription {
                         "output" => Causality::Output,
                         "local" => Causality::Local,
                         "independent" => Causality::Independent,
-                        other => {
+                        _ => {
                             return Err(fail(format!(
-                                "variable `{name}`: unknown causality `{other}`"
+                                "variable `{}`: causality is none of parameter, \
+                                 calculatedParameter, input, output, local, independent",
+                                shown(&name)
                             )))
                         }
                     };
                     if empty {
-                        return Err(fail(format!("variable `{name}` has no type element")));
+                        return Err(fail(format!(
+                            "variable `{}` has no type element",
+                            shown(&name)
+                        )));
                     }
                     pending = Some((name, vr, causality));
                 }
@@ -179,6 +262,7 @@ impl ModelDescription {
                 "no CoSimulation element: not a co-simulation FMU".into(),
             ));
         }
+        check_value_references(&md.variables, origin)?;
         Ok(md)
     }
 
@@ -196,14 +280,65 @@ impl ModelDescription {
     }
 }
 
+/// Two variables of one base type (Integer and Enumeration count as one) may share a value
+/// reference only as aliases (FMI 2.0 §2.2.7), and an alias set has at most one start value:
+/// at most one of them is an input or a parameter, and an input is aliased to nothing (it
+/// would move another variable the master did not set). Any other sharing is refused, naming
+/// both variables.
+fn check_value_references(variables: &[Variable], origin: &Path) -> Result<(), SlaveError> {
+    let class = |t: VarType| match t {
+        VarType::Real => "Real",
+        VarType::Integer | VarType::Enumeration => "Integer",
+        VarType::Boolean => "Boolean",
+        VarType::String => "String",
+    };
+    let settable = |c: Causality| matches!(c, Causality::Input | Causality::Parameter);
+    // (class, vr) → the first variable with it and the settable one of the set, if any.
+    let mut seen: HashMap<(&str, u32), (usize, Option<usize>)> = HashMap::new();
+    for (i, v) in variables.iter().enumerate() {
+        let key = (class(v.var_type), v.value_reference);
+        match seen.get_mut(&key) {
+            None => {
+                seen.insert(key, (i, settable(v.causality).then_some(i)));
+            }
+            Some((first, setter)) => {
+                let other = match (*setter, settable(v.causality)) {
+                    (Some(s), true) => Some(s),
+                    _ if v.causality == Causality::Input => Some(*first),
+                    _ if variables[*first].causality == Causality::Input => Some(*first),
+                    (None, true) => {
+                        *setter = Some(i);
+                        None
+                    }
+                    _ => None,
+                };
+                if let Some(o) = other {
+                    return Err(SlaveError::from(FmuRefused::DuplicateValueReference {
+                        path: origin.to_path_buf(),
+                        vr: v.value_reference,
+                        kind: key.0,
+                        first: shown(&variables[o].name),
+                        second: shown(&v.name),
+                    }));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn attribute(e: &BytesStart, key: &str) -> Result<Option<String>, String> {
     match e.try_get_attribute(key) {
         Ok(Some(a)) => a
             .unescape_value()
             .map(|v| Some(v.into_owned()))
-            .map_err(|err| format!("attribute {key}: {err}")),
+            .map_err(|_| {
+                format!("attribute {key}: an unknown entity or a bad character reference")
+            }),
         Ok(None) => Ok(None),
-        Err(err) => Err(format!("attribute {key}: {err}")),
+        Err(_) => Err(format!(
+            "attribute {key}: not written as {key}=\"value\", once"
+        )),
     }
 }
 

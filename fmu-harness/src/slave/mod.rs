@@ -4,13 +4,17 @@
 //! status and what the FMU logged. Reading `modelDescription.xml` is `description.rs`'s.
 
 mod description;
+mod extract;
 
-pub use description::{Causality, DefaultExperiment, ModelDescription, VarType, Variable};
+pub use description::{
+    Causality, DefaultExperiment, ModelDescription, VarType, Variable, MAX_MODEL_IDENTIFIER_BYTES,
+};
+pub use extract::{MAX_ENTRIES, MAX_EXTRACTED_BYTES, MAX_NAME_BYTES};
 
 use crate::fmi2_binding::{self, Api, FmuState, Instance, LogMessage, Refusal, Status};
+use crate::scratch::Scratch;
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use thiserror::Error;
 
@@ -31,6 +35,9 @@ pub enum SlaveError {
     },
     #[error("{}: modelDescription.xml: {message}", .path.display())]
     ModelDescription { path: PathBuf, message: String },
+    /// The FMU was refused as unsafe or absurd (boxed: [`FmuRefused`] carries the figures).
+    #[error(transparent)]
+    Refused(Box<FmuRefused>),
     #[error(transparent)]
     Load(#[from] fmi2_binding::LoadError),
     #[error("{function} returned {status}{}", messages_suffix(.messages))]
@@ -53,39 +60,94 @@ pub enum SlaveError {
     Nul { what: &'static str },
 }
 
+/// Why the master refuses an FMU it was given (issue 35): an archive entry, a limit, the model
+/// description or the binary; each variant carries the names and figures its message gives.
+#[derive(Debug, Error)]
+pub enum FmuRefused {
+    #[error(
+        "{}: line {line}, column {column}: not well-formed XML: {expected}",
+        .path.display()
+    )]
+    XmlSyntax {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        expected: String,
+    },
+    #[error(
+        "{}: modelIdentifier \"{shown}\" ({bytes} bytes) {reason}; the master needs a plain \
+         identifier ([A-Za-z_][A-Za-z0-9_]*, at most {limit} bytes) to name the binary",
+        .path.display()
+    )]
+    ModelIdentifier {
+        path: PathBuf,
+        shown: String,
+        bytes: usize,
+        limit: usize,
+        reason: &'static str,
+    },
+    #[error(
+        "{}: valueReference {vr} of {kind} variable `{second}` is also `{first}`'s; aliases \
+         may share one only if at most one of them is an input or a parameter, and an input \
+         has none",
+        .path.display()
+    )]
+    DuplicateValueReference {
+        path: PathBuf,
+        vr: u32,
+        kind: &'static str,
+        first: String,
+        second: String,
+    },
+    #[error("{}: entry `{entry}` {reason}: the master refuses the FMU", .path.display())]
+    UnsafeEntry {
+        path: PathBuf,
+        entry: String,
+        reason: &'static str,
+    },
+    #[error(
+        "{}: {entries} entries; the master extracts at most {limit}",
+        .path.display()
+    )]
+    TooManyEntries {
+        path: PathBuf,
+        entries: usize,
+        limit: usize,
+    },
+    #[error(
+        "{}: {} {bytes} bytes (up to entry `{entry}`); the master extracts at most {limit} \
+         bytes",
+        .path.display(),
+        if *.declared { "declares" } else { "expands to at least" }
+    )]
+    TooLarge {
+        path: PathBuf,
+        entry: String,
+        bytes: u64,
+        declared: bool,
+        limit: u64,
+    },
+    #[error("{}: entry `{entry}`: {source}", .path.display())]
+    Entry {
+        path: PathBuf,
+        entry: String,
+        source: std::io::Error,
+    },
+    #[error("{}: the model's binary {reason}; the master loads only a regular file of the FMU", .path.display())]
+    Binary { path: PathBuf, reason: &'static str },
+}
+
+impl From<FmuRefused> for SlaveError {
+    fn from(r: FmuRefused) -> Self {
+        SlaveError::Refused(Box::new(r))
+    }
+}
+
 fn messages_suffix(messages: &[LogMessage]) -> String {
     messages
         .iter()
         .map(|m| format!("\n  [{}] {}: {}", m.status, m.category, m.message))
         .collect()
-}
-
-/// A fresh directory under the system temp dir, unique within and across processes.
-fn unique_directory(stem: &str) -> Result<PathBuf, SlaveError> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let base = std::env::temp_dir();
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.subsec_nanos())
-        .unwrap_or(0);
-    loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = base.join(format!(
-            "fmu-harness-{}-{n}-{nanos}-{stem}",
-            std::process::id()
-        ));
-        match std::fs::create_dir(&dir) {
-            Ok(()) => return Ok(dir),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(source) => {
-                return Err(SlaveError::Io {
-                    path: dir,
-                    action: "creating the extraction directory",
-                    source,
-                })
-            }
-        }
-    }
 }
 
 /// `file://` URI of a directory (absolute path, unreserved characters and `/` kept).
@@ -108,7 +170,7 @@ pub struct Slave {
     pub model_description: ModelDescription,
     instance: Option<Instance>,
     api: Arc<Api>,
-    dir: PathBuf,
+    dir: Scratch,
 }
 
 impl Slave {
@@ -122,33 +184,24 @@ impl Slave {
             .chars()
             .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
             .collect();
-        let dir = unique_directory(&stem)?;
-        match Self::load_into(fmu, &dir) {
-            Ok((model_description, api)) => Ok(Slave {
-                model_description,
-                instance: None,
-                api,
-                dir,
-            }),
-            Err(e) => {
-                let _ = std::fs::remove_dir_all(&dir);
-                Err(e)
-            }
-        }
+        let stem: String = stem.chars().take(64).collect();
+        let dir = Scratch::directory(&stem).map_err(|source| SlaveError::Io {
+            path: std::env::temp_dir(),
+            action: "creating the extraction directory",
+            source,
+        })?;
+        // On an error `dir` is dropped here, which removes it.
+        let (model_description, api) = Self::load_into(fmu, dir.path())?;
+        Ok(Slave {
+            model_description,
+            instance: None,
+            api,
+            dir,
+        })
     }
 
     fn load_into(fmu: &Path, dir: &Path) -> Result<(ModelDescription, Arc<Api>), SlaveError> {
-        let zip_err = |source| SlaveError::Zip {
-            path: fmu.to_path_buf(),
-            source,
-        };
-        let file = std::fs::File::open(fmu).map_err(|source| SlaveError::Io {
-            path: fmu.to_path_buf(),
-            action: "opening the FMU",
-            source,
-        })?;
-        let mut archive = zip::ZipArchive::new(file).map_err(zip_err)?;
-        archive.extract(dir).map_err(zip_err)?;
+        extract::extract(fmu, dir)?;
         let md_path = dir.join("modelDescription.xml");
         let xml = std::fs::read_to_string(&md_path).map_err(|source| SlaveError::Io {
             path: fmu.join("modelDescription.xml"),
@@ -160,13 +213,14 @@ impl Slave {
             .join("binaries")
             .join(PLATFORM)
             .join(format!("{}.so", md.model_identifier));
+        extract::binary_inside(dir, &so)?;
         let api = Api::load(&so)?;
         Ok((md, api))
     }
 
     /// The directory the FMU was extracted to (removed on drop).
     pub fn directory(&self) -> &Path {
-        &self.dir
+        self.dir.path()
     }
 
     /// `fmi2Instantiate` as co-simulation, resources at the extracted `resources/`; replaces
@@ -178,10 +232,11 @@ impl Slave {
         })?;
         let guid = CString::new(self.model_description.guid.as_str())
             .map_err(|_| SlaveError::Nul { what: "the GUID" })?;
-        let uri =
-            CString::new(file_uri(&self.dir.join("resources"))).map_err(|_| SlaveError::Nul {
+        let uri = CString::new(file_uri(&self.dir.path().join("resources"))).map_err(|_| {
+            SlaveError::Nul {
                 what: "the resource URI",
-            })?;
+            }
+        })?;
         let instance = Instance::instantiate(&self.api, &name, &guid, &uri, false, logging_on)
             .map_err(|messages| SlaveError::Instantiate { messages })?;
         self.instance = Some(instance);
@@ -370,7 +425,6 @@ impl Drop for Slave {
     fn drop(&mut self) {
         // fmi2FreeInstance first, while the library is loaded; the files go last.
         self.instance = None;
-        let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
 

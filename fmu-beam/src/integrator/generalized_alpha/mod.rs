@@ -19,7 +19,7 @@ use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
 use crate::error::EngineError;
-use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Turning};
+use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Point, Turning};
 use nalgebra::DVector;
 
 mod error_control;
@@ -220,6 +220,11 @@ const SPLIT: f64 = 1e-6;
 const LAND: f64 = 1e-6;
 /// A remainder this short (relative to the step) before a landing point takes no implicit step.
 const TINY: f64 = 1e-6;
+/// The work budget of one call of [`Stepper::advance`] (one communication step): internal
+/// steps tried, accepted or refused. At about 10 µs a step of a small scene, 10 s of work; a
+/// communication step that needs more (a force of 1e18 N, gravity of 1e9 m/s², a doStep of
+/// 1e6 s) ends in [`EngineError::WorkBudget`] (fmi2Discard) instead of running for hours.
+pub const MAX_ATTEMPTS: u64 = 1_000_000;
 
 /// Where the factorized iteration matrix was evaluated. The factors are not stored: a restored
 /// state factorizes the matrix again at this point, so that it continues bit for bit.
@@ -471,7 +476,17 @@ impl Stepper {
                 t >= t_end - TINY * set.max_step
             }
         };
+        let (t_start, mut attempts) = (st.t, 0u64);
         while !reached(st.t) {
+            if attempts >= MAX_ATTEMPTS {
+                return Err(EngineError::WorkBudget {
+                    t_start,
+                    t: st.t,
+                    t_end,
+                    attempts,
+                });
+            }
+            attempts += 1;
             // the next time a step must end on: a jump of a drive law, the end of the
             // communication step when landing, the end of a divided fixed step
             // every jump ahead, however close: one a sliver ahead is met after a Taylor step

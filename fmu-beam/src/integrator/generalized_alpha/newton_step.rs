@@ -6,21 +6,15 @@
 use super::*;
 
 impl Stepper {
-    /// Builds and factorizes the scaled iteration matrix at a point.
-    #[allow(clippy::too_many_arguments)]
+    /// Builds and factorizes the scaled iteration matrix at a point, for a step h.
     pub(super) fn factorize<S: Equations + ?Sized>(
         &mut self,
         sys: &S,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        qdd: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
+        at: &Point,
         h: f64,
         c: &Coefficients,
     ) -> bool {
-        self.matrix
-            .factorize(sys, q, v, qdd, lambda, t, c.scaling(h))
+        self.matrix.factorize(sys, at, c.scaling(h))
     }
 
     /// Solves for the Newton correction at iterate `q` in `rhs`. Where the bodies have turned
@@ -80,7 +74,14 @@ impl Stepper {
         // a restored state: the same factors, at the same point
         if !self.matrix.is_factored() {
             if let Some(p) = self.memory.point.take() {
-                if !self.factorize(sys, &p.q, &p.v, &p.qdd, &p.lambda, p.t, p.h, &c) {
+                let at = Point {
+                    q: &p.q,
+                    v: &p.v,
+                    a: &p.qdd,
+                    lambda: &p.lambda,
+                    t: p.t,
+                };
+                if !self.factorize(sys, &at, p.h, &c) {
                     self.forget();
                     return Err(Failure::Singular);
                 }
@@ -110,7 +111,14 @@ impl Stepper {
         let kappa = KAPPA.min(INCREMENT_SHARE * self.settings.tolerance * increment);
         for it in 0..MAX_NEWTON {
             if !self.matrix.is_factored() {
-                if !self.factorize(sys, &q, &v, &qdd, &lambda, t_new, h, &c) {
+                let at = Point {
+                    q: &q,
+                    v: &v,
+                    a: &qdd,
+                    lambda: &lambda,
+                    t: t_new,
+                };
+                if !self.factorize(sys, &at, h, &c) {
                     self.forget();
                     return Err(Failure::Singular);
                 }

@@ -1,6 +1,6 @@
 //! Beam sections and finite elements (planar paper §3): the element layer, the bottom of the
 //! mechanics. It imports nothing from the scene format (`tests/layers.rs` checks it): a beam is
-//! built from its own numbers and [`FloatingFrame`]; `mechanics/from_scene.rs` turns a scene's
+//! built from its own numbers and [`FloatingFrame`]; `mechanics/from_scene/` turns a scene's
 //! entries into them.
 
 pub(crate) mod planar_beam;

@@ -6,9 +6,24 @@
 
 use super::sparsity::{BlockDiagonal, JacobianRows};
 use crate::error::EngineError;
-use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector};
 use std::ops::Range;
+
+/// A point of the equations: coordinates q, rates q', accelerations q'', multipliers λ and
+/// time t, where the integrator evaluates the tangents and the iteration matrix.
+#[derive(Debug, Clone, Copy)]
+pub struct Point<'a> {
+    /// Coordinates q.
+    pub q: &'a DVector<f64>,
+    /// Rates q'.
+    pub v: &'a DVector<f64>,
+    /// Accelerations q''.
+    pub a: &'a DVector<f64>,
+    /// Lagrange multipliers λ.
+    pub lambda: &'a DVector<f64>,
+    /// Time (s).
+    pub t: f64,
+}
 
 /// How a coordinate's local error is weighed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -60,8 +75,8 @@ pub trait Equations {
     fn coordinate_kinds(&self) -> Vec<CoordinateKind>;
     /// Indices in q of the bodies' frame coordinates (moved to assemble, never deformed).
     fn frame_coordinates(&self) -> Vec<usize>;
-    /// Coordinates before assembly (from the scene, or the system's own placement).
-    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError>;
+    /// Coordinates before assembly: the system's placement at t = 0 (with its initial shapes).
+    fn initial_coordinates(&self) -> Result<DVector<f64>, EngineError>;
     /// Coordinates of each body in q, consecutive and covering 0..n: M, K_t and C_t have
     /// entries only in these diagonal blocks.
     fn body_ranges(&self) -> Vec<Range<usize>>;
@@ -81,17 +96,7 @@ pub trait Equations {
     );
     /// K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten (approximations only
     /// slow Newton; coupling terms between bodies are left out).
-    #[allow(clippy::too_many_arguments)]
-    fn tangent_blocks(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        kt: &mut BlockDiagonal,
-        ct: &mut BlockDiagonal,
-    );
+    fn tangent_blocks(&self, at: &Point, kt: &mut BlockDiagonal, ct: &mut BlockDiagonal);
     /// Constraint residual g(q, t).
     fn constraints(&self, q: &DVector<f64>, t: f64, g: &mut DVector<f64>);
     /// Constraint Jacobian G = ∂g/∂q by rows, overwritten.
@@ -122,19 +127,9 @@ pub trait Equations {
         b.to_dense(m);
     }
     /// K_t and C_t, dense (n × n), overwritten.
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        kt: &mut DMatrix<f64>,
-        ct: &mut DMatrix<f64>,
-    ) {
+    fn tangents(&self, at: &Point, kt: &mut DMatrix<f64>, ct: &mut DMatrix<f64>) {
         let (mut kb, mut cb) = (self.block_diagonal(), self.block_diagonal());
-        self.tangent_blocks(q, v, a, lambda, t, &mut kb, &mut cb);
+        self.tangent_blocks(at, &mut kb, &mut cb);
         kb.to_dense(kt);
         cb.to_dense(ct);
     }

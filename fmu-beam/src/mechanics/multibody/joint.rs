@@ -4,8 +4,30 @@
 use super::frame::FrameState;
 use super::law::{InputValue, TimeLaw};
 use super::{prismatic, revolute, weld};
-use crate::scene::{DriveKind, JointKind};
 use nalgebra::Vector2;
+
+/// The kinds of joint, planar and spatial (their rows: the planar ones in [`super::weld`],
+/// [`super::revolute`] and [`super::prismatic`]; the spatial ones in `multibody3d::joint`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JointKind {
+    /// No relative motion (3 rows in the plane, 6 in space).
+    Weld,
+    /// Rotation about frame 0's z axis (2 rows in the plane, 5 in space).
+    Revolute,
+    /// Translation along frame 0's x axis (2 rows in the plane, 5 in space).
+    Prismatic,
+    /// Rotation about a common point (3 rows in space; in the plane it acts as revolute).
+    Spherical,
+}
+
+/// What a drive prescribes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DriveKind {
+    /// The joint coordinate follows the law (one more constraint row).
+    Motion,
+    /// A torque or force given by the law acts across the joint (a generalized force).
+    Effort,
+}
 
 /// One constraint equation between frames 0 and 1. Its Jacobian on the body of frame i is
 /// J_pᵀ w_i + J_φ c_i (see [`FrameState::for_each_jacobian`]).
@@ -99,24 +121,6 @@ pub struct Drive {
     pub kind: DriveKind,
     /// The joint coordinate (rad or m) or the effort (N·m or N) as a function of time.
     pub law: TimeLaw,
-}
-
-impl Drive {
-    /// The drive of a scene joint, if it has one; an `input` law reads the joint's input slot.
-    pub fn of_joint(
-        j: &crate::scene::JointSpec,
-        slots: &[crate::mechanics::multibody::system::InputSlot],
-    ) -> Option<Drive> {
-        j.drive.as_ref().map(|d| Drive {
-            kind: d.kind,
-            law: TimeLaw::from_spec(
-                &d.law,
-                slots
-                    .iter()
-                    .position(|s| s.name.starts_with(&format!("{}.drive.", j.name))),
-            ),
-        })
-    }
 }
 
 #[derive(Debug, Clone)]

@@ -1,6 +1,5 @@
 //! Scalar time laws of drives: value and first two time derivatives.
 
-use crate::scene::LawSpec;
 use std::f64::consts::PI;
 
 /// An FMU input held over a communication step, or extrapolated from the derivatives the master
@@ -69,28 +68,6 @@ pub struct TimeLaw {
 }
 
 impl TimeLaw {
-    /// Builds a validated law; `slot` is the input slot for law "input".
-    pub fn from_spec(spec: &LawSpec, slot: Option<usize>) -> TimeLaw {
-        let v = spec.value.unwrap_or(0.0);
-        let law = match spec.law.as_str() {
-            "exponential" => Law::Exponential {
-                value: v,
-                tau: spec.time_constant.unwrap_or(1.0),
-            },
-            "spin_up" => Law::SpinUp {
-                omega: spec.omega.unwrap_or(0.0),
-                ramp: spec.ramp_time.unwrap_or(1.0),
-            },
-            "table" => Law::Table(spec.table.clone().unwrap_or_default()),
-            "input" => Law::Input(slot.unwrap_or(0)),
-            _ => Law::Constant(v),
-        };
-        TimeLaw {
-            law,
-            until: spec.until,
-        }
-    }
-
     /// (f(t), f'(t), f''(t)).
     pub fn eval(&self, t: f64, inputs: &[InputValue]) -> (f64, f64, f64) {
         if self.until.is_some_and(|u| t > u) {
@@ -148,6 +125,14 @@ impl TimeLaw {
             Law::Table(rows) => b.extend(rows.iter().map(|r| r[0])),
             _ => {}
         }
+        b
+    }
+
+    /// The breakpoints of several laws (a system's drives and loads), sorted, each once.
+    pub fn breakpoints_of<'a>(laws: impl IntoIterator<Item = &'a TimeLaw>) -> Vec<f64> {
+        let mut b: Vec<f64> = laws.into_iter().flat_map(TimeLaw::breakpoints).collect();
+        b.sort_by(|x, y| x.total_cmp(y));
+        b.dedup();
         b
     }
 }

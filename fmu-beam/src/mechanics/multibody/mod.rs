@@ -12,6 +12,6 @@ pub(crate) mod sparsity;
 pub(crate) mod system;
 pub(crate) mod weld;
 
-pub use equations::{CoordinateKind, Equations, Turning};
+pub use equations::{CoordinateKind, Equations, Point, Turning};
 pub use sparsity::{BlockDiagonal, JacobianRows};
 pub use system::System;

@@ -4,9 +4,9 @@
 //! r(q, q', q'', λ, t) = Σ_bodies r_body - Q_loads(q, t) + G(q)ᵀ λ,   g(q, t) = 0.
 
 use super::body::Body;
-use super::equations::Turning;
+use super::equations::{Point, Turning};
 use super::frame::{self, Frame, FrameState};
-use super::joint::{Drive, Joint, Rows};
+use super::joint::{DriveKind, Joint, JointKind, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
 use super::sparsity::{BlockDiagonal, JacobianRows};
@@ -14,11 +14,9 @@ use crate::error::EngineError;
 use crate::mechanics::beam::planar_beam::TermCounts;
 use crate::mechanics::beam::planar_beam::{rot, PlanarBeam, PointMap, THETA};
 use crate::mechanics::Effects;
-use crate::scene::{DriveKind, JointKind, Scene};
-use nalgebra::{DMatrix, DVector, DVectorView, Vector2};
+use nalgebra::{DVector, DVectorView, Vector2};
 use std::ops::Range;
 
-mod build;
 mod readouts;
 
 /// Energies of the system (J).
@@ -35,61 +33,6 @@ impl Energy {
     }
 }
 
-/// An FMU input of the scene, in slot order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct InputSlot {
-    pub name: String,
-    pub unit: &'static str,
-    pub start: f64,
-    pub description: String,
-}
-
-/// The FMU inputs a scene offers: drives with law "input", then loads marked `input`.
-pub fn input_slots(scene: &Scene) -> Vec<InputSlot> {
-    let mut slots = Vec::new();
-    for j in &scene.joints {
-        if let Some(d) = j.drive.as_ref().filter(|d| d.law.law == "input") {
-            let (what, unit) = match (j.kind, d.kind) {
-                (JointKind::Prismatic, DriveKind::Motion) => ("position", "m"),
-                (JointKind::Prismatic, DriveKind::Effort) => ("force", "N"),
-                (_, DriveKind::Motion) => ("angle", "rad"),
-                (_, DriveKind::Effort) => ("torque", "N.m"),
-            };
-            slots.push(InputSlot {
-                name: format!("{}.drive.{what}", j.name),
-                unit,
-                start: d.law.value.unwrap_or(0.0),
-                description: format!("Drive of joint {}: prescribed {what}", j.name),
-            });
-        }
-    }
-    for l in scene.loads.iter().filter(|l| l.input) {
-        let planar = [
-            ("fx", "N", l.force[0]),
-            ("fy", "N", l.force[1]),
-            ("torque", "N.m", l.torque[2]),
-        ];
-        let spatial = [
-            ("fx", "N", l.force[0]),
-            ("fy", "N", l.force[1]),
-            ("fz", "N", l.force[2]),
-            ("tx", "N.m", l.torque[0]),
-            ("ty", "N.m", l.torque[1]),
-            ("tz", "N.m", l.torque[2]),
-        ];
-        let parts: &[(&str, &'static str, f64)] = if scene.is_3d() { &spatial } else { &planar };
-        for &(what, unit, start) in parts {
-            slots.push(InputSlot {
-                name: format!("{}.{what}", l.name),
-                unit,
-                start,
-                description: format!("Load {} on {}: {what} (world axes)", l.name, l.frame),
-            });
-        }
-    }
-    slots
-}
-
 /// A point load: world force and torque on a frame, constant or from input slots.
 #[derive(Debug, Clone)]
 pub struct Load {
@@ -103,16 +46,32 @@ pub struct Load {
     pub scale: Option<TimeLaw>,
 }
 
-/// A scene beam: one body, or k substructures welded tip to root.
+/// A beam of a system, planar or spatial: one body, or k substructures welded tip to root,
+/// consecutive among the system's bodies. `X` is what a system keeps more of it (the planar
+/// one: [`PlanarBeamData`]; the spatial one nothing).
 #[derive(Debug, Clone)]
-pub struct BeamGroup {
+pub struct BeamGroup<X = ()> {
+    /// The beam's name (its substructures are `name[i]`).
     pub name: String,
+    /// Its bodies, from flange a to flange b.
     pub bodies: Range<usize>,
+    /// Its undeformed length (m).
     pub length: f64,
+    /// What the system keeps more of the beam.
+    pub more: X,
+}
+
+/// What the planar system keeps of a beam for its readouts and its initial shape.
+#[derive(Debug, Clone)]
+pub struct PlanarBeamData {
+    /// A pinned floating frame: deflections are measured from the chord, not the root's axis.
     pub pinned: bool,
+    /// Its section (for the outputs of stress).
     pub section: crate::mechanics::beam::section::Section,
     /// The material point at mid-span.
     pub mid: (usize, PointMap),
+    /// Tip displacement (m) of the static shape the beam starts in; 0: undeformed.
+    pub initial_tip: f64,
 }
 
 /// The assembled planar system: its bodies stacked in q, the frames that joints and loads act
@@ -130,20 +89,53 @@ pub struct System {
     /// The point loads.
     pub loads: Vec<Load>,
     /// One group per scene beam, in scene order: its bodies (substructures) and section.
-    pub beams: Vec<BeamGroup>,
+    pub beams: Vec<BeamGroup<PlanarBeamData>>,
     /// The gravity field, `None` when the effect is off (its terms are not evaluated).
     pub gravity: Option<Vector2<f64>>,
     /// The resolved effects the system was built with.
     pub effects: Effects,
     /// Current values of the FMU inputs (slot order of `input_slots`).
     pub inputs: Vec<InputValue>,
-    n: usize,
-    m: usize,
+    /// Coordinates of the bodies where they are placed at t = 0, undeformed (before assembly).
+    pub placed: DVector<f64>,
+    pub(crate) n: usize,
+    pub(crate) m: usize,
 }
 
 impl System {
-    fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>) -> f64 {
+    pub(crate) fn relative_angle(&self, f0: usize, f1: usize, q: &DVector<f64>) -> f64 {
         self.frame_state(f1, q, None).phi - self.frame_state(f0, q, None).phi
+    }
+
+    /// Coordinates at t = 0 before assembly: the bodies where they are placed, each beam in
+    /// the static shape of its initial tip displacement.
+    pub fn initial_coordinates(&self) -> Result<DVector<f64>, EngineError> {
+        let mut q = self.placed.clone();
+        for g in &self.beams {
+            if g.more.initial_tip == 0.0 {
+                continue;
+            }
+            let body = g.bodies.start;
+            let b = self.beam(body).ok_or_else(|| EngineError::InitialState {
+                message: format!("beam '{}' is rigid: it has no initial deformation", g.name),
+            })?;
+            let shape = b.static_tip_shape(g.more.initial_tip).ok_or_else(|| {
+                EngineError::InitialState {
+                    message: format!(
+                        "beam '{}': no static tip shape (is the tip held by the frame?)",
+                        b.name
+                    ),
+                }
+            })?;
+            q.rows_mut(self.offsets[body] + 3, b.nflex())
+                .copy_from(&shape);
+        }
+        Ok(q)
+    }
+
+    pub(crate) fn add_frame(&mut self, f: Frame) -> usize {
+        self.frames.push(f);
+        self.frames.len() - 1
     }
 
     /// The flexible beam that is body `i`, if it is one.
@@ -388,8 +380,8 @@ impl super::equations::Equations for System {
     fn frame_coordinates(&self) -> Vec<usize> {
         self.offsets.iter().flat_map(|&o| o..o + 3).collect()
     }
-    fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
-        System::initial_coordinates(self, scene)
+    fn initial_coordinates(&self) -> Result<DVector<f64>, EngineError> {
+        System::initial_coordinates(self)
     }
     /// Coordinates of each body in q.
     fn body_ranges(&self) -> Vec<Range<usize>> {
@@ -460,16 +452,8 @@ impl super::equations::Equations for System {
     /// Tangents K_t = ∂(r + Gᵀλ)/∂q and C_t = ∂r/∂q' by body blocks, overwritten. The terms
     /// from the rotation of a prismatic axis and of effort drives are left out (Newton
     /// converges without them); a reaction or load only acts on its own body's block.
-    fn tangent_blocks(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        t: f64,
-        kt: &mut BlockDiagonal,
-        ct: &mut BlockDiagonal,
-    ) {
+    fn tangent_blocks(&self, at: &Point, kt: &mut BlockDiagonal, ct: &mut BlockDiagonal) {
+        let Point { q, v, a, lambda, t } = *at;
         kt.fill_zero();
         ct.fill_zero();
         for (i, b) in self.bodies.iter().enumerate() {
@@ -548,17 +532,9 @@ impl super::equations::Equations for System {
     }
     /// Times where a drive law jumps, for the integrator to land on.
     fn breakpoints(&self) -> Vec<f64> {
-        let mut b: Vec<f64> = self
-            .joints
-            .iter()
-            .filter_map(|j| j.drive.as_ref())
-            .map(|d| &d.law)
-            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
-            .flat_map(TimeLaw::breakpoints)
-            .collect();
-        b.sort_by(|x, y| x.total_cmp(y));
-        b.dedup();
-        b
+        let drives = self.joints.iter().filter_map(|j| j.drive.as_ref());
+        let loads = self.loads.iter().filter_map(|l| l.scale.as_ref());
+        TimeLaw::breakpoints_of(drives.map(|d| &d.law).chain(loads))
     }
     /// Names of the joints whose equations are in the given constraint rows.
     fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {

@@ -10,29 +10,15 @@
 //!   s − s(t); an effort drive is a generalized force along the coordinate.
 
 use super::quaternion::rotation_error;
-use crate::mechanics::multibody::joint::Drive;
+use crate::mechanics::multibody::joint::{Drive, DriveKind, JointKind};
 use crate::mechanics::multibody::law::InputValue;
-use crate::scene::DriveKind;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
-
-/// The kinds of spatial joint (their rows are in the module doc).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum JointKind3 {
-    /// No relative motion (6 rows).
-    Weld,
-    /// Rotation about frame 0's z axis (5 rows).
-    Revolute,
-    /// Translation along frame 0's x axis (5 rows).
-    Prismatic,
-    /// Rotation about a common point (3 rows).
-    Spherical,
-}
 
 #[derive(Debug, Clone)]
 pub struct Joint3 {
     pub name: String,
-    pub kind: JointKind3,
+    pub kind: JointKind,
     /// Indices into the system's frames.
     pub frames: [usize; 2],
     pub drive: Option<Drive>,
@@ -55,12 +41,12 @@ pub fn wrap(x: f64) -> f64 {
 
 impl Joint3 {
     /// Number of constraint rows.
-    pub fn rows_count(kind: JointKind3, drive: Option<&Drive>) -> usize {
+    pub fn rows_count(kind: JointKind, drive: Option<&Drive>) -> usize {
         let motion = drive.is_some_and(|d| d.kind == DriveKind::Motion) as usize;
         match kind {
-            JointKind3::Weld => 6,
-            JointKind3::Revolute | JointKind3::Prismatic => 5 + motion,
-            JointKind3::Spherical => 3,
+            JointKind::Weld => 6,
+            JointKind::Revolute | JointKind::Prismatic => 5 + motion,
+            JointKind::Spherical => 3,
         }
     }
 
@@ -78,11 +64,11 @@ impl Joint3 {
         let (x0, a0) = f0;
         let (x1, a1) = f1;
         match self.kind {
-            JointKind3::Revolute => {
+            JointKind::Revolute => {
                 let e = a1.column(0);
                 e.dot(&a0.column(1)).atan2(e.dot(&a0.column(0)))
             }
-            JointKind3::Prismatic => (x1 - x0).dot(&a0.column(0)),
+            JointKind::Prismatic => (x1 - x0).dot(&a0.column(0)),
             _ => 0.0,
         }
     }
@@ -98,28 +84,28 @@ impl Joint3 {
             k += 1;
         };
         match self.kind {
-            JointKind3::Weld => {
+            JointKind::Weld => {
                 d.iter().for_each(|&v| push(v));
                 rotation_error(a0, a1).iter().for_each(|&v| push(v));
             }
-            JointKind3::Revolute => {
+            JointKind::Revolute => {
                 d.iter().for_each(|&v| push(v));
                 let z1 = a1.column(2);
                 push(z1.dot(&a0.column(0)));
                 push(z1.dot(&a0.column(1)));
             }
-            JointKind3::Prismatic => {
+            JointKind::Prismatic => {
                 rotation_error(a0, a1).iter().for_each(|&v| push(v));
                 push(d.dot(&a0.column(1)));
                 push(d.dot(&a0.column(2)));
             }
-            JointKind3::Spherical => d.iter().for_each(|&v| push(v)),
+            JointKind::Spherical => d.iter().for_each(|&v| push(v)),
         }
         if let Some(dr) = self.drive.as_ref().filter(|d| d.kind == DriveKind::Motion) {
             let (s, _, _) = dr.law.eval(t, inputs);
             let c = self.coordinate(f0, f1);
             push(match self.kind {
-                JointKind3::Revolute => wrap(c - s),
+                JointKind::Revolute => wrap(c - s),
                 _ => c - s,
             });
         }
@@ -155,23 +141,23 @@ impl Joint3 {
             push(0.5 * (w[(1, 0)] - w[(0, 1)]));
         };
         match self.kind {
-            JointKind3::Weld => {
+            JointKind::Weld => {
                 dd.iter().for_each(|&v| push(v));
                 rotation_rows(&mut push);
             }
-            JointKind3::Revolute => {
+            JointKind::Revolute => {
                 dd.iter().for_each(|&v| push(v));
                 for c in 0..2 {
                     push(col_product(f1, r1, a1, 2, f0, r0, a0, c));
                 }
             }
-            JointKind3::Prismatic => {
+            JointKind::Prismatic => {
                 rotation_rows(&mut push);
                 for c in 1..3 {
                     push(gap_product(f0, f1, r0, r1, a0, a1, c));
                 }
             }
-            JointKind3::Spherical => dd.iter().for_each(|&v| push(v)),
+            JointKind::Spherical => dd.iter().for_each(|&v| push(v)),
         }
         if self
             .drive
@@ -196,7 +182,7 @@ impl Joint3 {
         a1: &Pose,
     ) -> f64 {
         match self.kind {
-            JointKind3::Revolute => {
+            JointKind::Revolute => {
                 let e = |m: &Matrix3<f64>| m.column(0).into_owned();
                 let (x, xd, xdd) = (e(&f1.1), e(&r1.1), e(&a1.1));
                 let c3 = |m: &Matrix3<f64>, i| m.column(i).into_owned();
@@ -214,7 +200,7 @@ impl Joint3 {
                 (c * sdd - s * cdd) / rho
                     - 2.0 * (c * sd - s * cd) * (s * sd + c * cd) / (rho * rho)
             }
-            JointKind3::Prismatic => gap_product(f0, f1, r0, r1, a0, a1, 0),
+            JointKind::Prismatic => gap_product(f0, f1, r0, r1, a0, a1, 0),
             _ => 0.0,
         }
     }

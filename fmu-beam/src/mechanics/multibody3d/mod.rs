@@ -30,7 +30,6 @@
 //! second derivative. The norm rows are exact.
 
 pub(crate) mod body;
-pub(crate) mod build;
 pub(crate) mod frame;
 pub(crate) mod joint;
 pub(crate) mod quaternion;
@@ -39,6 +38,5 @@ pub(crate) mod system;
 
 pub use body::Body3;
 pub use frame::Frame3;
-pub use joint::JointKind3;
 pub use rigid_body::RigidBody3;
 pub use system::{Load3, System3};

@@ -9,17 +9,18 @@
 
 use super::body::{Body3, FRAME};
 use super::frame::Frame3;
-use super::joint::{wrap, Joint3, JointKind3, Pose};
+use super::joint::{wrap, Joint3, Pose};
 use super::quaternion::from_rotation;
 use super::rigid_body::RigidBody3;
 use crate::error::EngineError;
 use crate::mechanics::beam::spatial_beam::{SpatialBeam, SpatialBeamProps};
-use crate::mechanics::multibody::equations::{CoordinateKind, Equations};
+use crate::mechanics::multibody::equations::{CoordinateKind, Equations, Point};
 use crate::mechanics::multibody::joint::Drive;
+use crate::mechanics::multibody::joint::JointKind;
 use crate::mechanics::multibody::law::{InputValue, TimeLaw};
 use crate::mechanics::multibody::sparsity::{BlockDiagonal, JacobianRows};
+use crate::mechanics::multibody::system::BeamGroup;
 use crate::mechanics::multibody::system::Energy;
-use crate::scene::Scene;
 use nalgebra::{DMatrix, DVector, DVectorView, Matrix3, Vector3};
 use std::ops::Range;
 
@@ -49,14 +50,6 @@ pub struct Load3 {
     pub law: Option<TimeLaw>,
 }
 
-/// A beam: one body, or k substructures welded tip to root.
-#[derive(Debug, Clone)]
-pub struct BeamGroup3 {
-    pub name: String,
-    pub bodies: Range<usize>,
-    pub length: f64,
-}
-
 /// The assembled spatial system: bodies stacked in q (z = [R, p, q_f] each), frames, joints
 /// and loads; the quaternions' norm rows come before the joints' rows in g(q).
 #[derive(Debug, Clone)]
@@ -72,7 +65,7 @@ pub struct System3 {
     /// The point loads.
     pub loads: Vec<Load3>,
     /// One group per beam, in the order added: its bodies (substructures) and length.
-    pub beams: Vec<BeamGroup3>,
+    pub beams: Vec<BeamGroup>,
     /// The gravity field (m/s², world axes), `None` when the effect is off (its terms are not
     /// evaluated).
     pub gravity: Option<Vector3<f64>>,
@@ -149,16 +142,17 @@ impl System3 {
             let fa = self.beam_flange(first + i, false);
             self.add_joint(
                 &format!("{name}.substructure{i}"),
-                JointKind3::Weld,
+                JointKind::Weld,
                 fb,
                 fa,
                 None,
             );
         }
-        self.beams.push(BeamGroup3 {
+        self.beams.push(BeamGroup {
             name: name.to_string(),
             bodies: first..first + k,
             length: props.length,
+            more: (),
         });
         self.beams.len() - 1
     }
@@ -174,10 +168,11 @@ impl System3 {
         let first = self.bodies.len();
         let (name, length) = (beam.name.clone(), beam.length);
         self.add_body(Body3::Beam(Box::new(beam)), position, &rotation);
-        self.beams.push(BeamGroup3 {
+        self.beams.push(BeamGroup {
             name,
             bodies: first..first + 1,
             length,
+            more: (),
         });
         self.beams.len() - 1
     }
@@ -238,7 +233,7 @@ impl System3 {
     pub fn add_joint(
         &mut self,
         name: &str,
-        kind: JointKind3,
+        kind: JointKind,
         f0: usize,
         f1: usize,
         drive: Option<Drive>,
@@ -390,7 +385,7 @@ impl System3 {
                 qq[k] = x - EPS_CENTRAL;
                 let cm = self.joint_coordinate(j, &qq);
                 qq[k] = x;
-                let d = if jt.kind == JointKind3::Revolute {
+                let d = if jt.kind == JointKind::Revolute {
                     wrap(cp - cm)
                 } else {
                     cp - cm
@@ -423,7 +418,7 @@ impl System3 {
                 qq[k] = x;
                 for s in 0..l {
                     let mut d = gp[s] - gn[s];
-                    if s == 5 && j.kind == JointKind3::Revolute {
+                    if s == 5 && j.kind == JointKind::Revolute {
                         d = wrap(d);
                     }
                     gm[(r + s, k)] = d / (2.0 * EPS_CENTRAL);
@@ -487,7 +482,8 @@ impl System3 {
         }
         for (j, jt) in self.joints.iter().enumerate() {
             let reads = jt.drive.as_ref().is_some_and(|d| {
-                d.kind == crate::scene::DriveKind::Effort && d.law.law == Law::Input(slot)
+                d.kind == crate::mechanics::multibody::joint::DriveKind::Effort
+                    && d.law.law == Law::Input(slot)
             });
             let Some(e) = jt.effort(t, &unit).filter(|_| reads) else {
                 continue;
@@ -606,7 +602,7 @@ impl Equations for System3 {
     }
 
     /// The system's own placement (built in code; the scene is not read).
-    fn initial_coordinates(&self, _scene: &Scene) -> Result<DVector<f64>, EngineError> {
+    fn initial_coordinates(&self) -> Result<DVector<f64>, EngineError> {
         Ok(DVector::from_vec(self.initial.clone()))
     }
 
@@ -662,16 +658,10 @@ impl Equations for System3 {
     /// Per body, forward differences of its residual over its own coordinates and rates; the
     /// norm rows' 2λ I exactly. Joint and load geometric terms are left out (Newton converges
     /// without them at the step sizes the dynamics need).
-    fn tangent_blocks(
-        &self,
-        q: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-        lambda: &DVector<f64>,
-        _t: f64,
-        kt: &mut BlockDiagonal,
-        ct: &mut BlockDiagonal,
-    ) {
+    fn tangent_blocks(&self, at: &Point, kt: &mut BlockDiagonal, ct: &mut BlockDiagonal) {
+        let Point {
+            q, v, a, lambda, ..
+        } = *at;
         kt.fill_zero();
         ct.fill_zero();
         let g = self.gravity.unwrap_or_default();
@@ -763,7 +753,7 @@ impl Equations for System3 {
                 self.joint_values(j, &qn, t, &mut gn[..l]);
                 for s in 0..l {
                     let (mut a, mut b) = (gp[s] - g0[s], gn[s] - g0[s]);
-                    if s == 5 && j.kind == JointKind3::Revolute {
+                    if s == 5 && j.kind == JointKind::Revolute {
                         (a, b) = (wrap(a), wrap(b));
                     }
                     out[r + s] = (a + b) / (h * h);
@@ -776,17 +766,9 @@ impl Equations for System3 {
     }
 
     fn breakpoints(&self) -> Vec<f64> {
-        let mut b: Vec<f64> = self
-            .joints
-            .iter()
-            .filter_map(|j| j.drive.as_ref())
-            .map(|d| &d.law)
-            .chain(self.loads.iter().filter_map(|l| l.law.as_ref()))
-            .flat_map(TimeLaw::breakpoints)
-            .collect();
-        b.sort_by(|x, y| x.total_cmp(y));
-        b.dedup();
-        b
+        let drives = self.joints.iter().filter_map(|j| j.drive.as_ref());
+        let loads = self.loads.iter().filter_map(|l| l.law.as_ref());
+        TimeLaw::breakpoints_of(drives.map(|d| &d.law).chain(loads))
     }
 
     fn joints_of_rows(&self, rows: &[usize]) -> Vec<String> {

@@ -10,6 +10,7 @@
 mod model;
 mod outputs;
 mod parameters;
+mod setting;
 mod state;
 mod validity;
 
@@ -67,6 +68,8 @@ struct ModelState {
 /// Everything that changes while an instance runs; get/set FMU state copy exactly this.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Snapshot {
+    /// The scene's fingerprint: a snapshot is restored only into an instance of the same model.
+    identity: u64,
     initialized: bool,
     start_time: f64,
     values: Vec<f64>,
@@ -98,6 +101,8 @@ pub struct Engine {
     model: Option<Model>,
     /// Accelerations consistent with the inputs set now, and their derivatives.
     feedthrough: crate::unit::interface::Feedthrough,
+    /// The scene's fingerprint: FMU states carry it, and only states of this model are restored.
+    identity: u64,
 }
 
 impl Engine {
@@ -111,6 +116,7 @@ impl Engine {
             .iter()
             .map(|v| v.start.unwrap_or(0.0))
             .collect();
+        let identity = Engine::identity_of(&scene);
         Engine {
             input_ders: vec![[0.0; 2]; values.len()],
             warned: vec![false; scene.beams.len()],
@@ -124,6 +130,7 @@ impl Engine {
             start_time: 0.0,
             model: None,
             feedthrough: Default::default(),
+            identity,
         }
     }
 
@@ -177,47 +184,6 @@ impl Engine {
     /// fmi2GetBoolean of one variable.
     pub fn get_boolean(&mut self, vr: u32) -> Result<bool, EngineError> {
         Ok(self.get(vr, VarType::Boolean)? != 0.0)
-    }
-
-    /// fmi2SetRealInputDerivatives: derivative of `order` (1 or 2) of a Real input, used to
-    /// extrapolate it over the next communication step.
-    pub fn set_input_derivative(
-        &mut self,
-        vr: u32,
-        order: i32,
-        value: f64,
-    ) -> Result<(), EngineError> {
-        let i = self.lookup(vr, VarType::Real)?;
-        let var = &self.table.variables[i];
-        let Binding::Input(slot) = var.binding else {
-            return Err(EngineError::NotSettable {
-                name: var.name.clone(),
-                reason: "input derivatives are only for inputs".into(),
-            });
-        };
-        if !(1..=2).contains(&order) {
-            return Err(EngineError::InvalidValue {
-                name: var.name.clone(),
-                value: order as f64,
-                rule: "derivative order must be 1 or 2 (MaxInputDerivativeOrder)".into(),
-            });
-        }
-        if !value.is_finite() {
-            return Err(EngineError::NonFiniteValue {
-                name: var.name.clone(),
-                value,
-            });
-        }
-        self.input_ders[i][order as usize - 1] = value;
-        if let Some(m) = &mut self.model {
-            let u = &mut m.system.inputs_mut()[slot];
-            if order == 1 {
-                u.der1 = value;
-            } else {
-                u.der2 = value;
-            }
-        }
-        Ok(())
     }
 
     /// Log messages (warnings) collected since the last call.
@@ -280,26 +246,6 @@ impl Engine {
         Ok(())
     }
 
-    /// Sets several Real variables as one fmi2SetReal call: the inputs' values first, then the
-    /// inputs that are their derivatives (a value resets its derivatives), whatever the order of
-    /// the references.
-    pub fn set_reals(&mut self, vr: &[u32], value: &[f64]) -> Result<(), EngineError> {
-        let is_derivative = |e: &Engine, r: u32| {
-            matches!(
-                e.table.get(r).map(|v| v.binding),
-                Some(Binding::InputDerivative { .. })
-            )
-        };
-        for pass in [false, true] {
-            for (&r, &v) in vr.iter().zip(value) {
-                if is_derivative(self, r) == pass {
-                    self.set_real(r, v)?;
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// The index (value reference) of the variable of input slot `slot`.
     fn input_var(&self, slot: usize) -> usize {
         self.table
@@ -317,65 +263,6 @@ impl Engine {
                 ty: ty.as_str(),
             }),
         }
-    }
-
-    fn set(&mut self, vr: u32, ty: VarType, value: f64) -> Result<(), EngineError> {
-        let i = self.lookup(vr, ty)?;
-        let var = &self.table.variables[i];
-        let name = var.name.clone();
-        if !value.is_finite() {
-            return Err(EngineError::NonFiniteValue { name, value });
-        }
-        if let Binding::InputDerivative { slot, order } = var.binding {
-            let base = self.input_var(slot) as u32;
-            return self.set_input_derivative(base, order as i32, value);
-        }
-        if let Binding::Input(slot) = var.binding {
-            self.values[i] = value;
-            self.input_ders[i] = [0.0; 2];
-            let t0 = self.time();
-            if let Some(m) = &mut self.model {
-                m.system.inputs_mut()[slot] = InputValue {
-                    value,
-                    der1: 0.0,
-                    der2: 0.0,
-                    t0,
-                };
-            }
-            return Ok(());
-        }
-        if !matches!(
-            (var.causality, var.binding),
-            (Causality::Parameter, Binding::Parameter(_))
-        ) {
-            return Err(EngineError::NotSettable {
-                name,
-                reason: format!("it is a {} variable", var.causality.as_str()),
-            });
-        }
-        if self.initialized && var.variability == Variability::Fixed {
-            return Err(EngineError::NotSettable {
-                name,
-                reason: "it is a fixed parameter and the instance is past initialization".into(),
-            });
-        }
-        // The scene's own rules decide what a value may be.
-        let mut trial = self.values.clone();
-        trial[i] = value;
-        let scene = self.scene_with(&trial);
-        if let Err(e) = scene.validate("parameters") {
-            let rule = match e {
-                crate::scene::SceneError::Invalid { rule, .. } => rule,
-                other => other.to_string(),
-            };
-            return Err(EngineError::InvalidValue { name, value, rule });
-        }
-        self.values[i] = value;
-        match &mut self.model {
-            Some(m) if self.initialized => m.stepper.set_settings(Settings::from_scene(&scene)),
-            _ => self.model = None,
-        }
-        Ok(())
     }
 
     fn get(&mut self, vr: u32, ty: VarType) -> Result<f64, EngineError> {
@@ -493,9 +380,9 @@ impl Engine {
                     };
                 }
             }
-            let state = integrator::initial_state(&system, &scene, self.start_time, &settings)?;
+            let state = integrator::initial_state(&system, self.start_time, &settings)?;
             let (joint_index, body_index) = match &system {
-                Mechanics::Planar(sys, _) => (
+                Mechanics::Planar(sys) => (
                     scene
                         .joints
                         .iter()

@@ -23,7 +23,7 @@ pub(super) fn planar_3d(
 pub(super) fn spatial_output(
     m: &Model,
     sys: &System3,
-    index: &crate::mechanics::multibody3d::build::SceneIndex,
+    index: &crate::mechanics::from_scene::SceneIndex,
     kind: OutputKind,
 ) -> f64 {
     use OutputKind as K;
@@ -101,7 +101,7 @@ pub(super) fn common_output(m: &Model, kind: OutputKind) -> f64 {
 pub(super) fn output(m: &Model, kind: OutputKind) -> f64 {
     use OutputKind as K;
     let sys = match &m.system {
-        Mechanics::Planar(sys, _) => sys,
+        Mechanics::Planar(sys) => sys,
         Mechanics::Spatial(sys, index) => return spatial_output(m, sys, index, kind),
     };
     let st = &m.state;
@@ -145,5 +145,5 @@ pub(super) fn beam_section(
     sys: &crate::mechanics::multibody::System,
     g: usize,
 ) -> crate::mechanics::beam::section::Section {
-    sys.beams[g].section
+    sys.beams[g].more.section
 }

@@ -1,18 +1,30 @@
 //! FMU state (fmi2GetFMUstate, fmi2SerializeFMUstate): a snapshot of everything that changes
-//! while an instance runs, its restore, and its byte form (versioned, fingerprinted by the
-//! scene, read back with bounds checks).
+//! while an instance runs, its restore (all or nothing: a refused one leaves the instance as it
+//! was), and its byte form (versioned, fingerprinted by the scene, closed by a checksum, read
+//! back with bounds checks and the scene's rules on its parameter values).
 
 use super::{Engine, Model, ModelState, Snapshot};
 use crate::error::EngineError;
 use crate::integrator::{write_vec, GaState, Memory, Reader, Stats};
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
-const STATE_VERSION: u32 = 5;
+const STATE_VERSION: u32 = 6;
+
+/// FNV-1a (64 bit) of `bytes` from `seed`: the scene's fingerprint and the serialized state's
+/// checksum. Any one changed byte changes it (each step is a bijection of the running value).
+fn fnv1a(seed: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(seed, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
 impl Engine {
     /// fmi2GetFMUstate: a copy of everything that changes while the instance runs.
     pub fn snapshot(&self) -> Snapshot {
         Snapshot {
+            identity: self.fingerprint(),
             initialized: self.initialized,
             start_time: self.start_time,
             values: self.values.clone(),
@@ -22,46 +34,73 @@ impl Engine {
     }
 
     /// fmi2SetFMUstate: the instance as it was at `s` (the model rebuilt from its parameter
-    /// values, the integration state put back); a state of another model is refused.
+    /// values, the integration state put back). A state of another model is refused, and a
+    /// refused restore leaves the instance exactly as it was.
     pub fn restore(&mut self, s: &Snapshot) -> Result<(), EngineError> {
-        self.values = s.values.clone();
-        self.input_ders = s.input_ders.clone();
-        self.start_time = s.start_time;
-        self.model = None;
-        self.initialized = false;
-        if let Some(saved) = &s.model {
-            let m = self.built()?;
-            let (n, k) = (m.state.q.len(), m.state.lambda.len());
-            let fits = |st: &GaState| st.q.len() == n && st.lambda.len() == k;
-            let ahead_fits = fits(&saved.front) && saved.back.as_ref().is_none_or(fits);
-            let point_fits = saved
-                .memory
-                .point
-                .as_ref()
-                .is_none_or(|p| p.q.len() == n && p.lambda.len() == k);
-            if !fits(&saved.state) || !ahead_fits || !point_fits {
-                return Err(EngineError::BadState {
-                    message: "the state does not belong to this model".into(),
-                });
-            }
-            if saved.applied_inputs.len() != m.applied_inputs.len() {
-                return Err(EngineError::BadState {
-                    message: "the state has another number of inputs".into(),
-                });
-            }
-            m.put_back(saved.clone());
+        if s.identity != self.fingerprint() || s.values.len() != self.values.len() {
+            return Err(EngineError::BadState {
+                message: "the state belongs to another model (its scene differs)".into(),
+            });
         }
-        self.initialized = s.initialized;
+        let before = (
+            std::mem::replace(&mut self.values, s.values.clone()),
+            std::mem::replace(&mut self.input_ders, s.input_ders.clone()),
+            std::mem::replace(&mut self.start_time, s.start_time),
+            self.model.take(),
+            std::mem::replace(&mut self.initialized, false),
+        );
+        let result = self.put_back_model(s);
+        match result {
+            Ok(()) => self.initialized = s.initialized,
+            Err(_) => {
+                (
+                    self.values,
+                    self.input_ders,
+                    self.start_time,
+                    self.model,
+                    self.initialized,
+                ) = before;
+            }
+        }
+        result
+    }
+
+    /// The model of the values just restored, with the integration state of `s`.
+    fn put_back_model(&mut self, s: &Snapshot) -> Result<(), EngineError> {
+        let Some(saved) = &s.model else {
+            return Ok(());
+        };
+        let m = self.built()?;
+        let (n, k) = (m.state.q.len(), m.state.lambda.len());
+        let fits = |st: &GaState| st.q.len() == n && st.lambda.len() == k;
+        let ahead_fits = fits(&saved.front) && saved.back.as_ref().is_none_or(fits);
+        let point_fits = saved
+            .memory
+            .point
+            .as_ref()
+            .is_none_or(|p| p.q.len() == n && p.lambda.len() == k);
+        if !fits(&saved.state) || !ahead_fits || !point_fits {
+            return Err(EngineError::BadState {
+                message: "the state does not belong to this model".into(),
+            });
+        }
+        if saved.applied_inputs.len() != m.applied_inputs.len() {
+            return Err(EngineError::BadState {
+                message: "the state has another number of inputs".into(),
+            });
+        }
+        m.put_back(saved.clone());
         Ok(())
     }
 
     /// A fingerprint of the scene, so that a state is only restored into the same model.
     fn fingerprint(&self) -> u64 {
-        // FNV-1a over the canonical scene text.
-        let text = self.scene.to_toml_string();
-        text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-        })
+        self.identity
+    }
+
+    /// The fingerprint of a scene: FNV-1a over its canonical text.
+    pub(super) fn identity_of(scene: &crate::scene::Scene) -> u64 {
+        fnv1a(FNV_OFFSET, scene.to_toml_string().as_bytes())
     }
 
     /// fmi2SerializeFMUstate: `s` as bytes, headed by the format's magic, version and the
@@ -94,16 +133,23 @@ impl Engine {
                 ms.memory.write(&mut w);
             }
         }
+        let sum = fnv1a(FNV_OFFSET, &w);
+        w.extend_from_slice(&sum.to_le_bytes());
         w
     }
 
     /// fmi2DeSerializeFMUstate: the snapshot of [`Engine::serialize`]'s bytes, every length
-    /// checked; bytes of another version or scene are refused.
+    /// checked; bytes of another version or scene, bytes whose checksum does not match (a
+    /// changed or truncated state), and parameter values the scene's rules refuse are refused.
     pub fn deserialize(&self, bytes: &[u8]) -> Result<Snapshot, EngineError> {
-        let mut r = Reader::new(bytes);
         let bad = |m: &str| EngineError::BadState {
             message: m.to_string(),
         };
+        let Some(split) = bytes.len().checked_sub(8) else {
+            return Err(bad("not a serialized state of this FMU (too short)"));
+        };
+        let (bytes, sum) = bytes.split_at(split);
+        let mut r = Reader::new(bytes);
         if r.take(8)? != STATE_MAGIC {
             return Err(bad(
                 "not a serialized state of this FMU (wrong magic bytes)",
@@ -111,6 +157,11 @@ impl Engine {
         }
         if r.u32()? != STATE_VERSION {
             return Err(bad("serialized state of another format version"));
+        }
+        if sum != fnv1a(FNV_OFFSET, bytes).to_le_bytes() {
+            return Err(bad(
+                "the serialized state is corrupt (its checksum does not match its bytes)",
+            ));
         }
         if r.u64()? != self.fingerprint() {
             return Err(bad("serialized state of another scene"));
@@ -157,7 +208,26 @@ impl Engine {
         if values.iter().chain(ders.iter()).any(|v| !v.is_finite()) || !start_time.is_finite() {
             return Err(bad("non-finite values"));
         }
+        if let Err(e) = self.scene_with(&values).validate("serialized state") {
+            return Err(EngineError::BadState {
+                message: format!("its parameter values break the scene's rules: {e}"),
+            });
+        }
+        if let Some(m) = &model {
+            let finite = |st: &GaState| {
+                st.t.is_finite()
+                    && st.h.is_finite()
+                    && [&st.q, &st.v, &st.acc, &st.qdd, &st.lambda]
+                        .iter()
+                        .all(|x| x.iter().all(|v| v.is_finite()))
+            };
+            let states = [Some(&m.state), Some(&m.front), m.back.as_ref()];
+            if !states.into_iter().flatten().all(finite) {
+                return Err(bad("non-finite values in the integration state"));
+            }
+        }
         Ok(Snapshot {
+            identity: self.fingerprint(),
             initialized,
             start_time,
             values,

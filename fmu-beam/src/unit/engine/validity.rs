@@ -23,7 +23,7 @@ impl Engine {
         let m = model.as_ref().expect("model built");
         let (q, t) = (&m.state.q, m.state.t);
         match &m.system {
-            Mechanics::Planar(sys, _) => {
+            Mechanics::Planar(sys) => {
                 for (g, grp) in sys.beams.iter().enumerate() {
                     let z0 = sys.body_coords(grp.bodies.start, q);
                     let (tip, _) = sys.beam_tip(g, q);

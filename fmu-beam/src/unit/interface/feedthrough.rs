@@ -3,6 +3,7 @@
 //! fmi2GetDirectionalDerivative, exact, from the factorized [[M, Gᵀ], [G, 0]].
 
 use super::*;
+use crate::mechanics::DriveKind;
 
 impl Feedthrough {
     /// Factorizes the matrix at (q, t) unless it already is.
@@ -208,7 +209,7 @@ pub(super) fn drive_of(
     j: usize,
 ) -> Option<(DriveKind, &crate::mechanics::multibody::law::TimeLaw)> {
     let d = match sys {
-        Mechanics::Planar(s, _) => s.joints[j].drive.as_ref(),
+        Mechanics::Planar(s) => s.joints[j].drive.as_ref(),
         Mechanics::Spatial(s, _) => s.joints[j].drive.as_ref(),
     };
     d.map(|d| (d.kind, &d.law))
@@ -256,7 +257,7 @@ pub(super) fn motion_rows(
     sys: &Mechanics,
 ) -> Vec<(usize, &crate::mechanics::multibody::law::TimeLaw)> {
     let joints = match sys {
-        Mechanics::Planar(s, _) => s.joints.len(),
+        Mechanics::Planar(s) => s.joints.len(),
         Mechanics::Spatial(s, _) => s.joints.len(),
     };
     (0..joints)
@@ -265,7 +266,7 @@ pub(super) fn motion_rows(
                 return None;
             };
             let row = match sys {
-                Mechanics::Planar(s, _) => {
+                Mechanics::Planar(s) => {
                     let jt = &s.joints[j];
                     jt.row
                         + crate::mechanics::multibody::joint::Joint::rows_count(
@@ -298,7 +299,7 @@ pub(super) fn second(sys: &Mechanics, s: usize, t: f64) -> Vec<InputValue> {
 /// its row).
 pub(super) fn joint_effort(sys: &Mechanics, j: usize, lambda: &DVector<f64>, t: f64) -> f64 {
     match sys {
-        Mechanics::Planar(s, _) => s.joint_effort(j, lambda, t),
+        Mechanics::Planar(s) => s.joint_effort(j, lambda, t),
         Mechanics::Spatial(s, _) => s.joint_effort(j, lambda, t),
     }
 }
@@ -306,7 +307,7 @@ pub(super) fn joint_effort(sys: &Mechanics, j: usize, lambda: &DVector<f64>, t: 
 /// ∂Q/∂u of one input slot at time t, as (coordinate, value) pairs.
 pub(super) fn input_force(sys: &Mechanics, st: &GaState, t: f64, slot: usize) -> Vec<(usize, f64)> {
     match sys {
-        Mechanics::Planar(s, _) => s.input_force(&st.q, &st.v, t, slot),
+        Mechanics::Planar(s) => s.input_force(&st.q, &st.v, t, slot),
         Mechanics::Spatial(s, _) => s.input_force(&st.q, t, slot),
     }
 }
@@ -321,7 +322,7 @@ pub(super) fn just_after(t: f64) -> f64 {
 pub(super) fn load_frame(sys: &Mechanics, scene: &Scene, load: usize) -> usize {
     let name = &scene.loads[load].name;
     match sys {
-        Mechanics::Planar(s, _) => {
+        Mechanics::Planar(s) => {
             s.loads
                 .iter()
                 .find(|l| &l.name == name)
@@ -350,7 +351,7 @@ pub(super) fn jacobian_times(
 ) -> f64 {
     use FrameQuantity as Q;
     match sys {
-        Mechanics::Planar(s, _) => {
+        Mechanics::Planar(s) => {
             let fs = s.frame_state(f, &st.q, None);
             let Some(b) = fs.body else { return 0.0 };
             let (w, c) = match what {
@@ -388,7 +389,7 @@ pub(super) fn frame_value(
     use FrameQuantity as Q;
     let (q, v) = (&st.q, &st.v);
     match sys {
-        Mechanics::Planar(s, _) => {
+        Mechanics::Planar(s) => {
             let fs = s.frame_state(f, q, Some(v));
             // a planar model: nothing leaves the plane, rotations are about z
             match what {

@@ -501,7 +501,7 @@ fn drive_parameters(t: &mut Builder, scene: &Scene) {
 fn inputs(t: &mut Builder, scene: &Scene) {
     use Causality as C;
     use Variability as V;
-    for (slot, input) in crate::mechanics::multibody::system::input_slots(scene)
+    for (slot, input) in crate::mechanics::from_scene::input_slots(scene)
         .into_iter()
         .enumerate()
     {

@@ -202,7 +202,7 @@ pub enum Binding {
     Parameter(ParamTarget),
     /// An output, computed from the state at the communication point.
     Output(OutputKind),
-    /// FMU input in this slot of `multibody::system::input_slots`.
+    /// FMU input in this slot of `from_scene::input_slots`.
     Input(usize),
     /// The first or second time derivative (`order` 1 or 2) of the motion input in `slot`, as
     /// an input of its own: the same value fmi2SetRealInputDerivatives sets.

@@ -74,7 +74,7 @@ impl System {
         let grp = &self.beams[g];
         let z0 = self.body_coords(grp.bodies.start, q);
         let root = Vector2::new(z0[0], z0[1]);
-        let axis = if grp.pinned {
+        let axis = if grp.more.pinned {
             let (tip, _) = self.beam_tip(g, q);
             let d = tip - root;
             if d.norm() > 0.0 {
@@ -91,7 +91,7 @@ impl System {
 
     /// World position of the beam's mid-span point.
     pub fn beam_mid(&self, g: usize, q: &DVector<f64>) -> Vector2<f64> {
-        let (body, map) = &self.beams[g].mid;
+        let (body, map) = &self.beams[g].more.mid;
         self.bodies[*body].point(map, self.body_coords(*body, q)).0
     }
 }

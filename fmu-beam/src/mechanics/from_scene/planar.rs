@@ -1,8 +1,20 @@
 //! The planar [`System`] of a validated scene: its beams (whole, substructured, rigid), rigid
 //! bodies, frames, joints with their drives, loads and gravity, computing the resolved effects;
-//! and its coordinates at t = 0 (the scene's placement and initial deflections).
+//! and where the scene places its bodies at t = 0 (with each beam's initial tip deflection).
 
-use super::*;
+use super::input_slots;
+use crate::mechanics::beam::planar_beam::{rot, PlanarBeam, PointMap};
+use crate::mechanics::beam::section::Section;
+use crate::mechanics::multibody::body::Body;
+use crate::mechanics::multibody::frame::Frame;
+use crate::mechanics::multibody::joint::{Drive, Joint, JointKind};
+use crate::mechanics::multibody::law::{InputValue, TimeLaw};
+use crate::mechanics::multibody::rigid_body::RigidBody;
+use crate::mechanics::multibody::system::{BeamGroup, Load, PlanarBeamData};
+use crate::mechanics::multibody::System;
+use crate::mechanics::Effects;
+use crate::scene::{FrameKind, Scene};
+use nalgebra::{DMatrix, DVector, Vector2};
 
 impl System {
     /// Assembles the system of a validated scene computing the given effects (resolved from
@@ -14,7 +26,7 @@ impl System {
             let (_, k) = Scene::beam_layout(spec);
             let k = if fx.rigid { 1 } else { k };
             let first = bodies.len();
-            let section = crate::mechanics::beam::section::Section::from_spec(&spec.section);
+            let section = Section::from_spec(&spec.section);
             if fx.rigid {
                 let mass = spec.material.rho * section.area * spec.length;
                 bodies.push(Body::Rigid(RigidBody {
@@ -57,9 +69,12 @@ impl System {
                 name: spec.name.clone(),
                 bodies: range,
                 length: spec.length,
-                pinned: spec.frame == crate::scene::FrameKind::Pinned,
-                section,
-                mid: (mid_body, mid_map),
+                more: PlanarBeamData {
+                    pinned: spec.frame == FrameKind::Pinned,
+                    section,
+                    mid: (mid_body, mid_map),
+                    initial_tip: spec.initial.tip_displacement,
+                },
             });
         }
         for spec in &scene.bodies {
@@ -100,10 +115,12 @@ impl System {
                     ..Default::default()
                 })
                 .collect(),
+            placed: DVector::zeros(0),
             n,
             m: 0,
         };
-        let q0 = sys.placed_coordinates(scene);
+        sys.placed = placed_coordinates(&sys, scene);
+        let q0 = sys.placed.clone();
         // substructure welds: flange b of each frame to flange a of the next
         let mut internal = Vec::new();
         for g in sys.beams.clone() {
@@ -142,11 +159,12 @@ impl System {
             let f0 = sys.frame_by_name(&j.frames[0]);
             let f1 = sys.frame_by_name(&j.frames[1]);
             let drive = Drive::of_joint(j, &slots);
+            let kind = JointKind::from(j.kind);
             let offset = sys.relative_angle(f0, f1, &q0);
-            let count = Joint::rows_count(j.kind, drive.as_ref());
+            let count = Joint::rows_count(kind, drive.as_ref());
             sys.joints.push(Joint {
                 name: j.name.clone(),
-                kind: j.kind,
+                kind,
                 frames: [f0, f1],
                 axis_angle: j.axis_angle,
                 angle_offset: offset,
@@ -178,13 +196,8 @@ impl System {
         sys
     }
 
-    pub(super) fn add_frame(&mut self, f: Frame) -> usize {
-        self.frames.push(f);
-        self.frames.len() - 1
-    }
-
     /// Resolves a (validated) frame name of the scene.
-    pub(super) fn frame_by_name(&mut self, name: &str) -> usize {
+    fn frame_by_name(&mut self, name: &str) -> usize {
         if name == "world" {
             return self.add_frame(Frame::World {
                 position: Vector2::zeros(),
@@ -218,55 +231,30 @@ impl System {
         };
         self.add_frame(frame)
     }
+}
 
-    /// Coordinates of the scene's placement, before assembly: frames where the scene puts
-    /// them, substructures in a row along their beam, and the initial deformed shapes.
-    pub(super) fn placed_coordinates(&self, scene: &Scene) -> DVector<f64> {
-        let mut q = DVector::zeros(self.n);
-        for (g, spec) in self.beams.iter().zip(&scene.beams) {
-            let k = g.bodies.len();
-            let (ar, _) = rot(spec.angle);
-            for (i, body) in g.bodies.clone().enumerate() {
-                let o = self.offsets[body];
-                let p = Vector2::new(spec.position[0], spec.position[1])
-                    + ar * Vector2::new(i as f64 * spec.length / k as f64, 0.0);
-                q[o] = p[0];
-                q[o + 1] = p[1];
-                q[o + 2] = spec.angle;
-            }
-        }
-        let first_rigid = self.beams.last().map_or(0, |g| g.bodies.end);
-        for (i, spec) in scene.bodies.iter().enumerate() {
-            let o = self.offsets[first_rigid + i];
-            q[o] = spec.position[0];
-            q[o + 1] = spec.position[1];
+/// Coordinates of the scene's placement, before assembly: frames where the scene puts
+/// them, substructures in a row along their beam, undeformed.
+fn placed_coordinates(sys: &System, scene: &Scene) -> DVector<f64> {
+    let mut q = DVector::zeros(sys.n);
+    for (g, spec) in sys.beams.iter().zip(&scene.beams) {
+        let k = g.bodies.len();
+        let (ar, _) = rot(spec.angle);
+        for (i, body) in g.bodies.clone().enumerate() {
+            let o = sys.offsets[body];
+            let p = Vector2::new(spec.position[0], spec.position[1])
+                + ar * Vector2::new(i as f64 * spec.length / k as f64, 0.0);
+            q[o] = p[0];
+            q[o + 1] = p[1];
             q[o + 2] = spec.angle;
         }
-        q
     }
-
-    /// Initial coordinates from the scene: placement plus the initial deformed shapes.
-    pub fn initial_coordinates(&self, scene: &Scene) -> Result<DVector<f64>, EngineError> {
-        let mut q = self.placed_coordinates(scene);
-        for (g, spec) in self.beams.iter().zip(&scene.beams) {
-            if spec.initial.tip_displacement == 0.0 {
-                continue;
-            }
-            let body = g.bodies.start;
-            let b = self.beam(body).ok_or_else(|| EngineError::InitialState {
-                message: format!("beam '{}' is rigid: it has no initial deformation", g.name),
-            })?;
-            let shape = b
-                .static_tip_shape(spec.initial.tip_displacement)
-                .ok_or_else(|| EngineError::InitialState {
-                    message: format!(
-                        "beam '{}': no static tip shape (is the tip held by the frame?)",
-                        b.name
-                    ),
-                })?;
-            q.rows_mut(self.offsets[body] + 3, b.nflex())
-                .copy_from(&shape);
-        }
-        Ok(q)
+    let first_rigid = sys.beams.last().map_or(0, |g| g.bodies.end);
+    for (i, spec) in scene.bodies.iter().enumerate() {
+        let o = sys.offsets[first_rigid + i];
+        q[o] = spec.position[0];
+        q[o + 1] = spec.position[1];
+        q[o + 2] = spec.angle;
     }
+    q
 }

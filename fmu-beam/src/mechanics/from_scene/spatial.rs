@@ -6,24 +6,25 @@
 //! plane), its local z the `normal` (default world z); a rigid body's frame is the world's
 //! turned by `angle` about z. A joint's two frames get the same world rotation W at t = 0:
 //! z along the axis of a revolute joint, x along the axis of a prismatic one, the identity for
-//! weld and spherical joints (the joint convention of [`super::joint`]); on a body that is
+//! weld and spherical joints (the joint convention of `multibody3d/joint.rs`); on a body that is
 //! the rotation offset Aᵀ W, with A the body's rotation at t = 0.
 
-use super::frame::Frame3;
-use super::joint::JointKind3;
-use super::rigid_body::RigidBody3;
-use super::system::{Load3, System3};
+use super::input_slots;
 use crate::mechanics::beam::spatial_beam::{
     InertiaModel, SpatialBeam, SpatialBeamProps, SpatialPointMap,
 };
 use crate::mechanics::beam::spatial_section::SpatialSection;
 use crate::mechanics::beam::FloatingFrame;
 use crate::mechanics::multibody::joint::Drive;
+use crate::mechanics::multibody::joint::JointKind;
 use crate::mechanics::multibody::law::TimeLaw;
-use crate::mechanics::multibody::system::input_slots;
+use crate::mechanics::multibody3d::frame::Frame3;
+use crate::mechanics::multibody3d::rigid_body::RigidBody3;
+use crate::mechanics::multibody3d::system::{Load3, System3};
+use crate::mechanics::multibody3d::Body3;
 use crate::mechanics::Effects;
 use crate::scene::matrix_file::{self, MatrixFile};
-use crate::scene::{BeamSpec, InertiaSpec, JointKind, LawSpec, Scene, SectionSpec};
+use crate::scene::{self, BeamSpec, InertiaSpec, LawSpec, Scene, SectionSpec};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Where the scene's parts are in the built system.
@@ -209,7 +210,7 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
         match o {
             Owner::Beam(g) => sys.beam_frame(*g, part == "b", offset),
             Owner::Rigid(body) => {
-                let Some(super::Body3::Rigid(r)) = sys.bodies.get(*body) else {
+                let Some(Body3::Rigid(r)) = sys.bodies.get(*body) else {
                     unreachable!("rigid owner")
                 };
                 let (s0, _) = r.frame(part).expect("validated body frame");
@@ -241,18 +242,18 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
                 .map_or(Matrix3::identity(), |o| o.2)
         };
         let (kind, w) = match j.kind {
-            JointKind::Weld => (JointKind3::Weld, Matrix3::identity()),
-            JointKind::Spherical => (JointKind3::Spherical, Matrix3::identity()),
-            JointKind::Revolute => {
+            scene::JointKind::Weld => (JointKind::Weld, Matrix3::identity()),
+            scene::JointKind::Spherical => (JointKind::Spherical, Matrix3::identity()),
+            scene::JointKind::Revolute => {
                 let axis = j.axis.map_or(Vector3::z(), Vector3::from);
-                (JointKind3::Revolute, along(axis, 2))
+                (JointKind::Revolute, along(axis, 2))
             }
-            JointKind::Prismatic => {
+            scene::JointKind::Prismatic => {
                 let (s, c) = j.axis_angle.sin_cos();
                 let axis = j
                     .axis
                     .map_or(first_rotation * Vector3::new(c, s, 0.0), Vector3::from);
-                (JointKind3::Prismatic, along(axis, 0))
+                (JointKind::Prismatic, along(axis, 0))
             }
         };
         let f0 = frame(&mut sys, &j.frames[0], w);
