@@ -245,6 +245,23 @@ def test_the_readme_quickstart_runs_as_written(venv, tmp_path):
     assert done.stdout.splitlines() == expected
 
 
+
+def test_an_interrupted_command_ends_at_once_and_leaves_no_temporary_file(venv, c1_fmu, tmp_path):
+    """Ctrl-C on `fmu-beam simulate` ends it as it ends fmu-harness: at once, with the signal's
+    status, its half-written CSV removed (Python's own handler would wait for the call)."""
+    import signal
+    csv = tmp_path / "run.csv"
+    run = subprocess.Popen([str(venv["root"] / "bin" / "fmu-beam"), "simulate", str(c1_fmu), "--stop", "1000",
+                            "-o", str(csv)], env=venv["env"], stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while not list(tmp_path.glob(".run.csv.tmp-*")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert list(tmp_path.glob(".run.csv.tmp-*")), "the run never started its CSV"
+    run.send_signal(signal.SIGINT)
+    assert run.wait(timeout=10) in (130, -signal.SIGINT)
+    assert list(tmp_path.iterdir()) == []
+
+
 WIN64_WHEELS = sorted(DIST.glob("fmu_beam-*-win_amd64.whl"))
 WIN64_HARNESS = ROOT / "target" / "win64" / "x86_64-win7-windows-gnu" / "release" / "fmu-harness.exe"
 

@@ -50,8 +50,11 @@ def engines() -> Dict[str, Path]:
 def main(argv: Optional[List[str]] = None) -> int:
     """The ``fmu-beam`` command (``argv`` without the program's name; default: ``sys.argv[1:]``):
     package, explain, modes, schema, reference, simulate, cosim, animate. Returns the exit
-    status: 0 on success, 2 for a refused scene, 1 for another error."""
-    args = sys.argv[1:] if argv is None else list(argv)
+    status: 0 on success, 2 for a refused scene, 1 for another error. Run as the command (no
+    ``argv``), an interrupt (Ctrl-C, SIGTERM) ends the process at once, as it ends
+    ``fmu-harness``, with its temporary files removed."""
+    as_command = argv is None
+    args = sys.argv[1:] if as_command else list(argv)
     sys.stdout.flush()
     sys.stderr.flush()
-    return _native.cli(["fmu-beam", *args])
+    return _native.cli(["fmu-beam", *args], as_command=as_command)

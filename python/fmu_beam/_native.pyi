@@ -108,6 +108,6 @@ def reference_text() -> str:
 def engines() -> Dict[str, str]:
     """The engine libraries this package carries: {platform: path}."""
 
-def cli(argv: List[str]) -> int:
+def cli(argv: List[str], as_command: bool = False) -> int:
     """Runs the ``fmu-beam`` command with ``argv`` (the program's name first); returns the exit
-    status."""
+    status. ``as_command``: an interrupt ends the process, its temporary files removed."""

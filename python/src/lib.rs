@@ -46,8 +46,12 @@ fn carried_engines<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
 /// Runs the `fmu-beam` command with `argv` (the program's name first): fmu-harness's command
 /// line under this name, `package` embedding this package's engines when given no
 /// `--binary`. Writes to the process's standard output and error; returns the exit status.
+/// `as_command` (the console script): SIGINT, SIGTERM and SIGHUP end the process at once, its
+/// temporary files removed, as they end `fmu-harness` (Python's own handler would wait for the
+/// call to return).
 #[pyfunction]
-fn cli(py: Python<'_>, argv: Vec<String>) -> PyResult<i32> {
+#[pyo3(signature = (argv, as_command = false))]
+fn cli(py: Python<'_>, argv: Vec<String>, as_command: bool) -> PyResult<i32> {
     let command = Cli::command()
         .name("fmu-beam")
         .bin_name("fmu-beam")
@@ -71,6 +75,11 @@ fn cli(py: Python<'_>, argv: Vec<String>) -> PyResult<i32> {
             return Ok(e.exit_code());
         }
     };
+    if as_command {
+        if let Err(e) = fmu_harness::scratch::remove_on_signals() {
+            eprintln!("warning: temporary files will stay behind if interrupted: {e}");
+        }
+    }
     let defaults = engines::carried()?;
     let status = py.detach(|| {
         errors::guard(|| {
