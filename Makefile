@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -71,8 +71,9 @@ win64-tools:
 	  || echo "win64-tools: could not install them" >&2; \
 	fi
 
+# The workspace but the Python extension, which `wheel` builds (maturin) from the same rlibs.
 release:
-	cargo build --release --workspace
+	cargo build --release --workspace --exclude fmu-beam-py
 
 # The Windows engine ($(WIN64_ENGINE)), when the toolchain is there; about 5 minutes from clean
 # on 2 cores (the standard library is built too), seconds when up to date. Waits for a build
@@ -105,6 +106,46 @@ fmus: release win64
 	done; \
 	if (( $${#failed[@]} )); then echo "fmus: could not package: $${failed[*]}" >&2; exit 1; fi
 
+# The Python package (issue 30; pyproject.toml, python/): dist/fmu_beam-<version>-cp39-abi3-
+# manylinux_2_28_x86_64.whl, one wheel for every CPython >= 3.9 on x86-64 Linux with glibc >= 2.28,
+# with the packager (the extension module fmu_beam._native, PyO3) and both engines as package data
+# (python/fmu_beam/engines/, which git ignores), so that its FMUs carry linux64 and win64.
+# manylinux_2_28: a plain link on this Debian (glibc 2.36) binds hypot, pow, exp and the pthread
+# keys to glibc 2.29-2.35 symbol versions, so maturin links with zig (ziglang, from PyPI) against
+# glibc 2.28's (`auditwheel show dist/*.whl` says which tag the wheel deserves). The linux64 engine
+# must be linked so too; maturin's cargo build makes it on the way (fmu-beam is a cdylib too), so a
+# first pass builds everything, the engine is copied in, and a second pass (nothing left to
+# compile) packs the wheel. The win64 engine is `make win64`'s.
+WHEEL_ENGINES := python/fmu_beam/engines
+WHEEL_TARGET  := x86_64-unknown-linux-gnu
+MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" nice $(VENV)/bin/maturin build --release \
+  --zig --compatibility manylinux_2_28
+wheel: .venv win64
+	rm -rf $(WHEEL_ENGINES) build/wheel/first dist/fmu_beam-*.whl
+	$(MATURIN) --out build/wheel/first
+	mkdir -p $(WHEEL_ENGINES)/linux64
+	cp target/$(WHEEL_TARGET)/release/deps/libfmu_beam.so $(WHEEL_ENGINES)/linux64/
+	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
+	  mkdir -p $(WHEEL_ENGINES)/win64 && cp $(WIN64_ENGINE) $(WHEEL_ENGINES)/win64/; fi
+	$(MATURIN) --out dist
+	rm -rf build/wheel/first
+
+# The win64 wheel (issue 30), not part of `make test` (about 5 more minutes of build): the same
+# package cross-built with the Windows engine's toolchain (Debian's rustc-web, -Zbuild-std,
+# mingw-w64; PyO3 links python3.dll by raw-dylib, so no Python import library is needed) into
+# dist/fmu_beam-<version>-cp39-abi3-win_amd64.whl, with the engines `make wheel` put in; and the
+# packager's command built the same way (target/win64/.../fmu-harness.exe), which
+# tests/test_wheel.py runs under Wine when it finds both.
+WIN64_HARNESS := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu-harness.exe
+wheel-win64: wheel
+	@$(WIN64_READY) || { $(WIN64_MISSING); exit 1; }
+	env PATH="/usr/bin:/bin:$(abspath $(VENV))/bin" RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
+	  CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
+	  nice $(VENV)/bin/maturin build --release --target $(WIN64_TARGET) -Z build-std=std,panic_unwind --out dist
+	env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
+	  CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc nice /usr/bin/cargo build \
+	  --release -p fmu-harness --bin fmu-harness --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+
 # The documents generated from the code (issue 16): the scene schema that editors read and the
 # scene reference; fmu-harness/tests/generated_docs.rs fails when the committed ones differ.
 docs: release
@@ -125,8 +166,9 @@ test: .venv tools browser win64-tools
 	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
 	fi
 	$(MAKE) --no-print-directory release
-	cargo test --workspace --release --no-fail-fast
+	cargo test --workspace --exclude fmu-beam-py --release --no-fail-fast
 	$(MAKE) --no-print-directory fmus
+	$(MAKE) --no-print-directory wheel
 	WIN64=$(WIN64) $(PY) -m pytest tests -q
 
 check:
@@ -187,7 +229,7 @@ example-sweep: .venv fmus
 	$(PY) examples/sweep.py
 
 clean:
-	rm -rf build .pytest_cache tests/__pycache__
+	rm -rf build dist $(WHEEL_ENGINES) .pytest_cache tests/__pycache__
 
 distclean: clean
 	rm -rf $(VENV)

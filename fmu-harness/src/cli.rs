@@ -99,12 +99,25 @@ pub enum Command {
 
 /// Runs one command, writing its report to `out`.
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), HarnessError> {
+    run_with_engines(cli, &[], out)
+}
+
+/// [`run`], where `package` without `--binary` embeds `engines` (the Python package's own, one
+/// per platform); with none, [`package::default_binary`].
+pub fn run_with_engines(
+    cli: Cli,
+    engines: &[package::BinaryArg],
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
     match cli.command {
         Command::Package {
             scene,
             output,
             binary,
-        } => package_cmd(&scene, &output, &binary, out),
+        } => {
+            let binary = if binary.is_empty() { engines } else { &binary };
+            package_cmd(&scene, &output, binary, out)
+        }
         Command::Simulate {
             fmu,
             stop,

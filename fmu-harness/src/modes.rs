@@ -10,8 +10,14 @@ pub const RIGID_BODY_LIMIT_HZ: f64 = 1e-6;
 /// The elastic natural frequencies (Hz, ascending) of the scene file.
 pub fn elastic_frequencies(scene_path: &Path) -> Result<Vec<f64>, HarnessError> {
     let scene = Scene::load(scene_path)?;
-    let f = fmu_beam::natural_frequencies(&scene).map_err(|source| HarnessError::Engine {
-        origin: scene_path.display().to_string(),
+    elastic_frequencies_of(&scene, &scene_path.display().to_string())
+}
+
+/// The elastic natural frequencies (Hz, ascending) of a loaded scene; `origin` (its file, or
+/// what the caller names it) prefixes an error.
+pub fn elastic_frequencies_of(scene: &Scene, origin: &str) -> Result<Vec<f64>, HarnessError> {
+    let f = fmu_beam::natural_frequencies(scene).map_err(|source| HarnessError::Engine {
+        origin: origin.to_string(),
         source,
     })?;
     Ok(f.into_iter()

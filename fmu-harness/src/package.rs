@@ -200,7 +200,15 @@ pub fn package(
     output: &Path,
     binaries: &[BinaryArg],
 ) -> Result<Packaged, HarnessError> {
-    let scene = Scene::load(scene_path)?;
+    package_scene(&Scene::load(scene_path)?, output, binaries)
+}
+
+/// [`package`] of a scene already loaded and validated (the Python package's `Scene.package`).
+pub fn package_scene(
+    scene: &Scene,
+    output: &Path,
+    binaries: &[BinaryArg],
+) -> Result<Packaged, HarnessError> {
     let given = if binaries.is_empty() {
         vec![BinaryArg {
             platform: None,
@@ -239,7 +247,7 @@ pub fn package(
         .iter()
         .map(|(p, _, b)| (*p, b.as_slice()))
         .collect();
-    let c = contents(&scene, &parts)?;
+    let c = contents(scene, &parts)?;
     let paths: Vec<String> = libraries
         .iter()
         .map(|(p, _, _)| {

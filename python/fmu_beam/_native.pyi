@@ -1,0 +1,113 @@
+"""Type stubs of the extension module fmu_beam._native (python/src/lib.rs); use it through
+``fmu_beam``, which re-exports these."""
+
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+
+__version__: str
+
+StrPath = Union[str, "os.PathLike[str]"]
+
+class Error(Exception):
+    """An error of fmu_beam: an engine library or a file that cannot be read or written, a
+    scene whose unit cannot be built, an FMU that cannot be run."""
+
+class SceneError(Error):
+    """A scene refused by the packager's validation; the message is the packager's."""
+
+    origin: str
+    """The scene file, or '<dict>' / '<string>' (the ``origin`` given)."""
+    field: Optional[str]
+    """The field's path, such as 'beam[0].length'; None when the text could not be read."""
+    value: Optional[str]
+    """The value refused, as written."""
+    rule: Optional[str]
+    """What the value breaks ('must be positive'), or the parser's message."""
+    code: Optional[str]
+    """The rule's code in the scene reference, or None."""
+
+class Packaged:
+    """What :meth:`Scene.package` wrote."""
+
+    @property
+    def path(self) -> str:
+        """The FMU written."""
+    @property
+    def model_identifier(self) -> str:
+        """Its modelIdentifier: the scene's name."""
+    @property
+    def guid(self) -> str:
+        """Its GUID: a digest of its model description, scene and engines."""
+    @property
+    def variables(self) -> int:
+        """How many variables it has."""
+    @property
+    def platforms(self) -> List[str]:
+        """The platforms it carries an engine for, e.g. ['linux64', 'win64']."""
+
+class Scene:
+    """A validated scene: loaded from a file, read from TOML text, or built from a dict."""
+
+    @staticmethod
+    def load(path: StrPath) -> "Scene":
+        """Reads and validates a scene file (TOML) as ``fmu-beam package`` does; a beam's
+        ``matrix_file`` is read relative to the file. Raises :class:`SceneError`."""
+    @staticmethod
+    def from_toml(text: str, origin: str = "<string>") -> "Scene":
+        """Parses and validates scene text (TOML); ``origin`` prefixes the messages."""
+    @staticmethod
+    def from_dict(
+        d: Mapping[str, Any], origin: str = "<dict>", directory: Optional[StrPath] = None
+    ) -> "Scene":
+        """Builds a scene from nested dicts and lists shaped like the TOML file (the scene
+        reference applies key for key; a key set to None takes its default) and validates it as
+        the packager does. A beam's ``matrix_file`` is read relative to ``directory`` (default:
+        the working directory). Raises :class:`SceneError` naming the field."""
+    @property
+    def name(self) -> str:
+        """The scene's name: the FMU's modelIdentifier."""
+    @property
+    def description(self) -> str:
+        """The scene's description."""
+    @property
+    def dimensions(self) -> int:
+        """2 (planar) or 3."""
+    @property
+    def origin(self) -> str:
+        """Where the scene came from: its file, '<dict>' or '<string>'."""
+    def to_toml(self) -> str:
+        """The canonical TOML text: what the FMU carries as resources/scene.toml."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The scene as nested dicts and lists, every default written out;
+        ``Scene.from_dict(s.to_dict()) == s``."""
+    def explain(self) -> str:
+        """The effects the unit simulates, why, and their estimated share of the cost."""
+    def modes(self, count: Optional[int] = None) -> List[float]:
+        """The linearized elastic natural frequencies in Hz, ascending (rigid-body modes left
+        out), at most ``count`` of them."""
+    def variables(self) -> List[Dict[str, Any]]:
+        """The unit's variables in value-reference order: name, value_reference, causality,
+        variability, type, unit, start, description."""
+    def package(
+        self,
+        path: StrPath,
+        platforms: Optional[Sequence[str]] = None,
+        binaries: Optional[Mapping[str, StrPath]] = None,
+    ) -> Packaged:
+        """Writes the scene's FMU to ``path`` with this package's engines of ``platforms``
+        ('linux64', 'win64'; default: all it carries), or with the engine libraries of
+        ``binaries`` ({'linux64': path, ...}, like ``--binary``)."""
+    def __eq__(self, other: object) -> bool: ...
+
+def schema_text() -> str:
+    """The JSON Schema of scene files, as text."""
+
+def reference_text() -> str:
+    """The scene reference, as Markdown."""
+
+def engines() -> Dict[str, str]:
+    """The engine libraries this package carries: {platform: path}."""
+
+def cli(argv: List[str], as_command: bool = False) -> int:
+    """Runs the ``fmu-beam`` command with ``argv`` (the program's name first); returns the exit
+    status. ``as_command``: an interrupt ends the process, its temporary files removed."""
