@@ -49,6 +49,19 @@ impl Refusal {
                 rule: Some(m.clone()),
                 ..Refusal::default()
             },
+            E::File {
+                origin,
+                field,
+                file,
+                rule,
+            } => Refusal {
+                message,
+                origin: origin.clone(),
+                field: Some(field.clone()),
+                value: Some(file.clone()),
+                rule: Some(rule.clone()),
+                code: None,
+            },
             E::Invalid {
                 origin,
                 field,

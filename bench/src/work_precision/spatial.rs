@@ -210,12 +210,14 @@ fn integrator(setting: Setting, comm: f64) -> Settings {
             tolerance: t,
             max_step: comm,
             rho_inf: RHO_INF,
+            step_budget: fmu_beam::integrator::DEFAULT_STEP_BUDGET,
         },
         Setting::FixedStep(h) => Settings {
             adaptive: false,
             tolerance: FIXED_STEP_NEWTON_TOLERANCE,
             max_step: h,
             rho_inf: RHO_INF,
+            step_budget: fmu_beam::integrator::DEFAULT_STEP_BUDGET,
         },
     }
 }

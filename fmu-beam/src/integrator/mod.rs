@@ -33,7 +33,16 @@ pub struct Settings {
     pub max_step: f64,
     /// Spectral radius at infinity ρ∞ of generalized-α (1): 1 = no numerical damping.
     pub rho_inf: f64,
+    /// The work budget of one communication step ([`Stepper::advance`]): internal steps tried,
+    /// accepted or refused; past it the step ends in [`EngineError::WorkBudget`] (a Discard).
+    pub step_budget: u64,
 }
+
+/// The default work budget of a communication step: at about 15 µs a step of a small scene
+/// (the pendulum), 15 s of work. A communication step that needs more (a force of 1e18 N,
+/// gravity of 1e9 m/s², a doStep of 1e6 s) ends in a Discard instead of running for hours;
+/// `solver.step_budget` sets it.
+pub const DEFAULT_STEP_BUDGET: u64 = 1_000_000;
 
 impl Settings {
     /// The settings of the scene's `solver` entry.
@@ -43,6 +52,7 @@ impl Settings {
             tolerance: scene.solver.tolerance,
             max_step: scene.solver.max_step,
             rho_inf: scene.solver.rho_inf,
+            step_budget: scene.solver.step_budget,
         }
     }
 }

@@ -308,6 +308,14 @@ pub(crate) const MAX_STEP: Rule = rule(
     Any,
     Schema::AtMost(super::validate::MAX_STEP),
 );
+/// Its text quotes [`super::validate::MAX_STEP_BUDGET`].
+pub(crate) const STEP_BUDGET: Rule = rule(
+    "step_budget",
+    &["solver.step_budget"],
+    "must lie in [1, 2147483647] (internal steps of one communication step, an fmi2Integer)",
+    Any,
+    Schema::Within(1.0, 2147483647.0),
+);
 pub(crate) const RHO_INF: Rule = rule(
     "rho_inf",
     &["solver.rho_inf"],
@@ -861,6 +869,7 @@ pub const RULES: &[Rule] = &[
     TOLERANCE_BELOW_ONE,
     MIN_STEP,
     MAX_STEP,
+    STEP_BUDGET,
     RHO_INF,
     STOP_AFTER_START,
     A_BEAM,

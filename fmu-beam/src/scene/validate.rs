@@ -125,6 +125,9 @@ pub const MIN_STEP: f64 = 1e-9;
 /// pendulum took no step and stayed at rest, at 1e5 s it stopped short, with fmi2OK.)
 pub const MAX_STEP: f64 = 1.0;
 
+/// The largest `solver.step_budget`: the largest fmi2Integer, so that the master can set it.
+pub const MAX_STEP_BUDGET: u64 = i32::MAX as u64;
+
 /// Characters allowed in names that become parts of FMI variable names.
 pub(super) fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
@@ -158,6 +161,9 @@ impl Scene {
         }
         if s.max_step > MAX_STEP {
             return Err(ck.fail(&r::MAX_STEP, "solver.max_step", s.max_step));
+        }
+        if !(1..=MAX_STEP_BUDGET).contains(&s.step_budget) {
+            return Err(ck.fail(&r::STEP_BUDGET, "solver.step_budget", s.step_budget));
         }
         ck.finite("solver.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {

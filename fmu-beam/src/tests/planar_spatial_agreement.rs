@@ -79,6 +79,7 @@ impl Grid {
             tolerance: self.tol,
             max_step: self.h,
             rho_inf: scene.solver.rho_inf,
+            step_budget: crate::integrator::DEFAULT_STEP_BUDGET,
         }
     }
 }

@@ -21,6 +21,7 @@ fn fixed(h: f64) -> Settings {
         tolerance: 1e-10,
         max_step: h,
         rho_inf: 0.9,
+        step_budget: crate::integrator::DEFAULT_STEP_BUDGET,
     }
 }
 
@@ -349,6 +350,7 @@ fn c6_flexible_pendulum_lags_its_rigid_twin() {
         tolerance,
         max_step: 1e-3,
         rho_inf: 0.9,
+        step_budget: crate::integrator::DEFAULT_STEP_BUDGET,
     };
     // the time by which the flexible pendulum trails the rigid one over the last 0.1 s
     let lag = |elements: usize, tolerance: f64| {

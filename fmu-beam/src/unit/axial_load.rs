@@ -45,6 +45,7 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
         tolerance: 1e-4,
         max_step: dt,
         rho_inf: scene.solver.rho_inf,
+        step_budget: crate::integrator::DEFAULT_STEP_BUDGET,
     };
     let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
     let mut stepper = Stepper::new(&sys, settings);

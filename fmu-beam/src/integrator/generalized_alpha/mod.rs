@@ -220,11 +220,6 @@ const SPLIT: f64 = 1e-6;
 const LAND: f64 = 1e-6;
 /// A remainder this short (relative to the step) before a landing point takes no implicit step.
 const TINY: f64 = 1e-6;
-/// The work budget of one call of [`Stepper::advance`] (one communication step): internal
-/// steps tried, accepted or refused. At about 10 µs a step of a small scene, 10 s of work; a
-/// communication step that needs more (a force of 1e18 N, gravity of 1e9 m/s², a doStep of
-/// 1e6 s) ends in [`EngineError::WorkBudget`] (fmi2Discard) instead of running for hours.
-pub const MAX_ATTEMPTS: u64 = 1_000_000;
 
 /// Where the factorized iteration matrix was evaluated. The factors are not stored: a restored
 /// state factorizes the matrix again at this point, so that it continues bit for bit.
@@ -478,7 +473,7 @@ impl Stepper {
         };
         let (t_start, mut attempts) = (st.t, 0u64);
         while !reached(st.t) {
-            if attempts >= MAX_ATTEMPTS {
+            if attempts >= set.step_budget {
                 return Err(EngineError::WorkBudget {
                     t_start,
                     t: st.t,

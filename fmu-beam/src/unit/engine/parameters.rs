@@ -17,6 +17,7 @@ pub(super) fn apply(s: &mut Scene, t: ParamTarget, v: f64) {
         T::SolverTolerance => s.solver.tolerance = v,
         T::SolverMaxStep => s.solver.max_step = v,
         T::SolverRhoInf => s.solver.rho_inf = v,
+        T::SolverStepBudget => s.solver.step_budget = v as u64,
         T::BeamLength(i) => s.beams[i].length = v,
         T::BeamRho(i) => s.beams[i].material.rho = v,
         T::BeamE(i) => s.beams[i].material.e = v,

@@ -314,6 +314,16 @@ fn solver_parameters(t: &mut Builder, scene: &Scene) {
         V::Tunable,
         "Generalized-alpha spectral radius at infinity (1: no numerical damping)",
     );
+    t.push(
+        "solver.step_budget".into(),
+        VarType::Integer,
+        C::Parameter,
+        V::Tunable,
+        None,
+        "Internal steps one communication step may take before it ends in fmi2Discard",
+        Some(s.step_budget as f64),
+        P(T::SolverStepBudget),
+    );
 }
 
 /// Each beam's material, section, damping and initial-state parameters (only those of the effects that are on).

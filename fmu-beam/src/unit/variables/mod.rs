@@ -102,6 +102,8 @@ pub enum ParamTarget {
     SolverTolerance,
     SolverMaxStep,
     SolverRhoInf,
+    /// `solver.step_budget`.
+    SolverStepBudget,
     BeamLength(usize),
     BeamRho(usize),
     BeamE(usize),
