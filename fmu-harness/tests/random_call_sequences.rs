@@ -1,8 +1,9 @@
 //! Random FMI call sequences through the project's own master (issue 7): illegal orders,
 //! unknown value references, NaN and negative steps, wrong communication points, calls after
 //! terminate and after another instance of the same unit was freed. Every call returns a
-//! status or a refusal with the FMU's message, nothing crashes, and a fresh instance afterwards runs bit for bit as
-//! one that never saw them. (Null pointers are sent straight to the exports in
+//! status or a refusal with the FMU's message, nothing crashes, a call refused with fmi2Error
+//! changes no value the instance shows (issue 35), and a fresh instance afterwards runs bit
+//! for bit as one that never saw them. (Null pointers are sent straight to the exports in
 //! fmu-beam/src/fmi2/abi_tests.rs; arrays of mismatched length cannot be sent: the binding
 //! refuses to build such a call, and a C master that did would overrun its own arrays.)
 
@@ -54,6 +55,8 @@ enum Call {
     DoStep(f64, bool),
     GetReal(u32),
     SetReal(u32, f64),
+    /// Several values in one call (all or nothing).
+    SetReals(Vec<(u32, f64)>),
     GetInteger(u32),
     SetBoolean(u32, bool),
     StateRoundTrip,
@@ -88,7 +91,15 @@ fn call() -> impl Strategy<Value = Call> {
         )
             .prop_map(|(h, t)| Call::DoStep(h, t)),
         (0u32..60).prop_map(Call::GetReal),
-        (0u32..60, value).prop_map(|(v, x)| Call::SetReal(v, x)),
+        (0u32..60, value.clone()).prop_map(|(v, x)| Call::SetReal(v, x)),
+        prop::collection::vec(
+            (
+                0u32..60,
+                prop_oneof![Just(2e-3), Just(1e-4), Just(0.5), value]
+            ),
+            2..5
+        )
+        .prop_map(Call::SetReals),
         (0u32..60).prop_map(Call::GetInteger),
         (0u32..60, any::<bool>()).prop_map(|(v, b)| Call::SetBoolean(v, b)),
         Just(Call::StateRoundTrip),
@@ -96,6 +107,18 @@ fn call() -> impl Strategy<Value = Call> {
         Just(Call::Terminate),
         Just(Call::FreeTheOther),
     ]
+}
+
+/// What the instance shows: every Real and Integer variable it lets be read now (a refused
+/// read is `None`), as bits.
+fn observe(a: &mut Slave) -> Vec<Option<u64>> {
+    let mut seen = Vec::new();
+    for vr in 0u32..60 {
+        seen.push(a.get_real(&[vr]).ok().map(|v| v[0].to_bits()));
+        seen.push(a.get_integer(&[vr]).ok().map(|v| v[0] as u64));
+    }
+    let _ = a.take_messages();
+    seen
 }
 
 #[test]
@@ -108,6 +131,7 @@ fn random_sequences_through_the_master_never_crash() {
         ..Config::default()
     });
     let counts = std::cell::RefCell::new((0usize, 0usize));
+    let checked = std::cell::Cell::new(0usize);
     runner
         .run(&prop::collection::vec(call(), 1..30), |calls| {
             let mut a = Slave::load(&fmu).unwrap();
@@ -137,6 +161,18 @@ fn random_sequences_through_the_master_never_crash() {
                 }
             };
             for c in &calls {
+                let before = observe(&mut a);
+                let refused_with_error = std::cell::Cell::new(false);
+                let check = |r: Result<Status, SlaveError>| {
+                    if let Err(SlaveError::Call {
+                        status: Status::Error,
+                        ..
+                    }) = &r
+                    {
+                        refused_with_error.set(true);
+                    }
+                    check(r)
+                };
                 let ok = match c {
                     Call::Setup(t0) => check(a.setup_experiment(None, *t0, None))?,
                     Call::Enter => check(a.enter_initialization_mode())?,
@@ -151,6 +187,10 @@ fn random_sequences_through_the_master_never_crash() {
                     }
                     Call::GetReal(v) => check(a.get_real(&[*v]).map(|_| Status::Ok))?,
                     Call::SetReal(v, x) => check(a.set_real(&[*v], &[*x]))?,
+                    Call::SetReals(vx) => {
+                        let (vr, x): (Vec<u32>, Vec<f64>) = vx.iter().copied().unzip();
+                        check(a.set_real(&vr, &x))?
+                    }
                     Call::GetInteger(v) => check(a.get_integer(&[*v]).map(|_| Status::Ok))?,
                     Call::SetBoolean(v, b) => check(a.set_boolean(&[*v], &[*b]))?,
                     Call::StateRoundTrip => {
@@ -169,6 +209,17 @@ fn random_sequences_through_the_master_never_crash() {
                         true
                     }
                 };
+                // a refusal changes nothing: every value readable after it is as before (an
+                // instance that went to state Error shows none)
+                if refused_with_error.get() && !matches!(c, Call::FreeTheOther) {
+                    let after = observe(&mut a);
+                    for (k, (x, y)) in before.iter().zip(&after).enumerate() {
+                        if y.is_some() {
+                            prop_assert_eq!(x, y, "{:?} refused but changed value {}", c, k / 2);
+                        }
+                    }
+                    checked.set(checked.get() + 1);
+                }
                 let mut n = counts.borrow_mut();
                 if ok {
                     n.0 += 1
@@ -181,8 +232,12 @@ fn random_sequences_through_the_master_never_crash() {
         })
         .unwrap();
     let (accepted, refused) = *counts.borrow();
-    println!("{accepted} calls accepted, {refused} refused with an error status");
-    assert!(refused > 100 && accepted > 100);
+    println!(
+        "{accepted} calls accepted, {refused} refused with an error status ({} checked for \
+         changes)",
+        checked.get()
+    );
+    assert!(refused > 100 && accepted > 100 && checked.get() > 100);
     assert_eq!(
         fresh_run(&fmu),
         reference,
