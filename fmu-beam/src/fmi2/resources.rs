@@ -116,10 +116,14 @@ fn percent_decode(s: &str) -> Result<String, String> {
     String::from_utf8(out).map_err(|_| "decodes to a path that is not UTF-8".to_string())
 }
 
+/// The most `guid.txt` may hold (bytes).
+const GUID_FILE_CAP: u64 = 1024;
+
 /// The GUID the packager wrote into `guid.txt` (trimmed).
 pub fn guid(dir: &Path) -> Result<String, String> {
     let path = dir.join("guid.txt");
-    let text = std::fs::read_to_string(&path)
+    // a regular file of a few bytes (a GUID is 36 characters); never a FIFO or a device
+    let text = crate::scene::files::read_capped(&path, GUID_FILE_CAP)
         .map_err(|e| format!("{}: cannot read the GUID of this FMU: {e}", path.display()))?;
     let guid = text.trim();
     if guid.is_empty() {
@@ -179,5 +183,30 @@ mod tests {
         assert!(directory_text("file://server/share/r", false).is_err());
         assert_eq!(directory_text("file:///C:/r", false), ok("/C:/r"));
         assert!(directory_text(r"C:\r", false).is_err());
+    }
+
+    /// `guid.txt` is read only as a small regular file: a FIFO or a huge file in an FMU's
+    /// resources is refused at once, with no byte of it in the message (issue 35).
+    #[cfg(unix)]
+    #[test]
+    fn the_guid_file_is_small_and_regular() {
+        let dir = std::env::temp_dir().join(format!("fmu-beam-guid-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("guid.txt");
+        std::fs::write(&path, "  {1234}\n").unwrap();
+        assert_eq!(guid(&dir), Ok("{1234}".to_string()));
+        std::fs::write(&path, "SECRET".repeat(1000)).unwrap();
+        let e = guid(&dir).unwrap_err();
+        assert!(
+            e.contains("at most 1024 bytes") && !e.contains("SECRET"),
+            "{e}"
+        );
+        std::fs::remove_file(&path).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&path).status();
+        if made.is_ok_and(|s| s.success()) {
+            let e = guid(&dir).unwrap_err();
+            assert!(e.contains("regular file"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
