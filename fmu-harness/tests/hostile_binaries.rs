@@ -8,13 +8,13 @@ use common::*;
 use fmu_harness::engine_library::MAX_LIBRARY_BYTES;
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// `fmu-harness package C1 -o <dir>/x.fmu --binary <binary>` within 20 s: (success, stderr).
 fn package_with(dir: &Path, binary: &str) -> (bool, String, Duration) {
     let err = dir.join("stderr.txt");
     let out = dir.join("x.fmu");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
+    let child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
         .arg("package")
         .arg(c1_path())
         .arg("-o")
@@ -24,18 +24,11 @@ fn package_with(dir: &Path, binary: &str) -> (bool, String, Duration) {
         .stderr(std::fs::File::create(&err).unwrap())
         .spawn()
         .expect("run fmu-harness");
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > Duration::from_secs(20) {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("package --binary {binary} did not return within 20 s");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    };
+    let (status, took) = wait_bounded(
+        child,
+        Duration::from_secs(20),
+        &format!("package --binary {binary}"),
+    );
     let stderr = std::fs::read_to_string(&err).unwrap_or_default();
     assert!(!stderr.contains("panicked"), "{stderr}");
     if !status.success() {
@@ -45,7 +38,7 @@ fn package_with(dir: &Path, binary: &str) -> (bool, String, Duration) {
             out.display()
         );
     }
-    (status.success(), stderr, start.elapsed())
+    (status.success(), stderr, took)
 }
 
 #[test]

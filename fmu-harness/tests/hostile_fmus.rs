@@ -11,7 +11,7 @@ mod common;
 use common::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 use zip::write::SimpleFileOptions;
 
@@ -32,21 +32,6 @@ struct Run {
     elapsed: Duration,
     /// `fmu-harness-*` entries left in the run's TMPDIR.
     left: Vec<PathBuf>,
-}
-
-fn wait_bounded(mut child: Child, limit: Duration, what: &str) -> (ExitStatus, Duration) {
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait for fmu-harness") {
-            return (status, start.elapsed());
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what}: fmu-harness did not return within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 fn leftovers(tmp: &Path) -> Vec<PathBuf> {

@@ -8,14 +8,14 @@ mod common;
 use common::*;
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const SECRET: &str = "root:x:0:0:SECRET:/root:/bin/bash";
 
 /// `fmu-harness <args>` within 20 s: (success, stderr).
 fn bounded(dir: &Path, args: &[&str]) -> (bool, String) {
     let err = dir.join("stderr.txt");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
+    let child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::null())
@@ -23,18 +23,11 @@ fn bounded(dir: &Path, args: &[&str]) -> (bool, String) {
         .stderr(std::fs::File::create(&err).unwrap())
         .spawn()
         .expect("run fmu-harness");
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > Duration::from_secs(20) {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("fmu-harness {args:?} did not return within 20 s");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    };
+    let (status, _) = wait_bounded(
+        child,
+        Duration::from_secs(20),
+        &format!("fmu-harness {args:?}"),
+    );
     let stderr = std::fs::read_to_string(&err).unwrap_or_default();
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(!stderr.contains("root:x"), "file content in: {stderr}");

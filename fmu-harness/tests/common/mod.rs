@@ -98,3 +98,24 @@ pub fn read_entry(fmu: &Path, name: &str) -> String {
     std::io::Read::read_to_string(&mut e, &mut s).expect("utf-8 entry");
     s
 }
+
+/// Waits for a spawned `fmu-harness` at most `limit` (a hang fails the test, naming `what`):
+/// its exit status and how long it took.
+pub fn wait_bounded(
+    mut child: std::process::Child,
+    limit: std::time::Duration,
+    what: &str,
+) -> (std::process::ExitStatus, std::time::Duration) {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait for fmu-harness") {
+            return (status, start.elapsed());
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what}: fmu-harness did not return within {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
