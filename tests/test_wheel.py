@@ -273,8 +273,9 @@ def test_the_win64_wheel_and_its_packager_under_wine(wheel, api_fmus, tmp_path):
     its extension imports only python3.dll (the stable ABI) and system DLLs, that it carries the
     Linux wheel's engines; and that the packager built with the same toolchain
     (fmu-harness.exe) runs under Wine and writes, with those engines, the very bytes the Linux
-    wheel's API wrote, which fmpy validates. Importing the .pyd into a Windows CPython is not
-    checked: none can be had here."""
+    wheel's API wrote, which fmpy validates, and simulates C1 with the win64 engine to the Linux
+    master's numbers bit for bit. Importing the .pyd into a Windows CPython is not checked: none
+    can be had here."""
     win = WIN64_WHEELS[-1]
     assert re.fullmatch(r"fmu_beam-[\w.]+-cp39-abi3-win_amd64\.whl", win.name), win.name
     z, linux = zipfile.ZipFile(win), zipfile.ZipFile(wheel)
@@ -308,3 +309,10 @@ def test_the_win64_wheel_and_its_packager_under_wine(wheel, api_fmus, tmp_path):
     assert done.returncode == 0, done.stderr
     assert validate_fmu(str(tmp_path / "c1.fmu")) == []
     assert (tmp_path / "c1.fmu").read_bytes() == (api_fmus / f"{C1}.fmu").read_bytes()
+    # the Windows master simulates the unit with its win64 engine: the Linux master's numbers
+    ran = subprocess.run(["wine", str(WIN64_HARNESS), "simulate", "c1.fmu", "-o", "win.csv"],
+                         env=env, cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert ran.returncode == 0, ran.stderr
+    subprocess.run([str(ROOT / "target" / "release" / "fmu-harness"), "simulate", "c1.fmu",
+                    "-o", "linux.csv"], cwd=tmp_path, check=True, capture_output=True)
+    assert (tmp_path / "win.csv").read_bytes() == (tmp_path / "linux.csv").read_bytes()

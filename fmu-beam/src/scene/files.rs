@@ -82,20 +82,23 @@ pub fn resolve_below(dir: &Path, name: &str) -> Result<PathBuf, FileRefusal> {
 
 /// What a file that is not regular is.
 fn kind_of(t: std::fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
     if t.is_dir() {
-        "directory"
-    } else if t.is_fifo() {
-        "FIFO"
-    } else if t.is_char_device() {
-        "character device"
-    } else if t.is_block_device() {
-        "block device"
-    } else if t.is_socket() {
-        "socket"
-    } else {
-        "special file"
+        return "directory";
     }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "FIFO";
+        } else if t.is_char_device() {
+            return "character device";
+        } else if t.is_block_device() {
+            return "block device";
+        } else if t.is_socket() {
+            return "socket";
+        }
+    }
+    "special file"
 }
 
 /// The text of the regular file at `path`, at most `cap` bytes: its type and size are checked
@@ -117,7 +120,16 @@ pub fn read_capped(path: &Path, cap: u64) -> Result<String, FileRefusal> {
         Ok(())
     };
     check(&meta)?;
-    let file = std::fs::File::open(path).map_err(io)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // O_NONBLOCK: a FIFO put there since the first look opens at once instead of waiting
+        // for a writer (and is refused by the second look)
+        options.custom_flags(0o4000);
+    }
+    let file = options.open(path).map_err(io)?;
     // the file may have been swapped between the two looks: look again at what was opened
     check(&file.metadata().map_err(io)?)?;
     let mut bytes = Vec::new();

@@ -18,7 +18,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use thiserror::Error;
 
-pub const PLATFORM: &str = "linux64";
+/// The FMI platform folder of the binary this master loads: the one of the machine it runs on
+/// (the win64 build of the master, in the win64 wheel, loads `binaries/win64/<id>.dll`).
+pub const PLATFORM: &str = if cfg!(windows) { "win64" } else { "linux64" };
+
+/// The file extension of that binary.
+const LIBRARY_EXTENSION: &str = if cfg!(windows) { "dll" } else { "so" };
 
 #[derive(Debug, Error)]
 pub enum SlaveError {
@@ -150,13 +155,36 @@ fn messages_suffix(messages: &[LogMessage]) -> String {
         .collect()
 }
 
-/// `file://` URI of a directory (absolute path, unreserved characters and `/` kept).
+/// `file://` URI of a directory (absolute path, unreserved characters and `/` kept). A Windows
+/// path (`C:\a\b`, as the win64 build of the master sees its temporary folder) becomes
+/// `file:///C:/a/b`, the form Windows masters send.
 fn file_uri(dir: &Path) -> String {
+    uri_of_path(dir.as_os_str().as_encoded_bytes(), cfg!(windows))
+}
+
+/// The URI of a path's bytes; `windows`: a Windows path (backslashes, a drive letter).
+fn uri_of_path(path: &[u8], windows: bool) -> String {
     let mut uri = String::from("file://");
-    for b in dir.as_os_str().as_encoded_bytes() {
+    let mut path = path.to_vec();
+    if windows {
+        let text = String::from_utf8_lossy(&path).into_owned();
+        let text = text
+            .strip_prefix(r"\\?\")
+            .unwrap_or(&text)
+            .replace('\\', "/");
+        let mut rest = text.as_str();
+        if rest.len() >= 2 && rest.as_bytes()[0].is_ascii_alphabetic() && rest.as_bytes()[1] == b':'
+        {
+            uri.push('/');
+            uri.push_str(&rest[..2]);
+            rest = &rest[2..];
+        }
+        path = rest.as_bytes().to_vec();
+    }
+    for b in path {
         match b {
             b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' | b'/' => {
-                uri.push(*b as char)
+                uri.push(b as char)
             }
             _ => uri.push_str(&format!("%{b:02X}")),
         }
@@ -212,7 +240,7 @@ impl Slave {
         let so = dir
             .join("binaries")
             .join(PLATFORM)
-            .join(format!("{}.so", md.model_identifier));
+            .join(format!("{}.{LIBRARY_EXTENSION}", md.model_identifier));
         extract::binary_inside(dir, &so)?;
         let api = Api::load(&so)?;
         Ok((md, api))
@@ -435,5 +463,10 @@ mod tests {
     #[test]
     fn file_uri_escapes_reserved_bytes() {
         assert_eq!(file_uri(Path::new("/tmp/a b%/r")), "file:///tmp/a%20b%25/r");
+        assert_eq!(
+            uri_of_path(br"C:\users\a b\Temp\fmu-harness-1\resources", true),
+            "file:///C:/users/a%20b/Temp/fmu-harness-1/resources"
+        );
+        assert_eq!(uri_of_path(br"\\?\D:\r", true), "file:///D:/r");
     }
 }
