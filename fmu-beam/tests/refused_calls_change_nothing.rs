@@ -74,6 +74,15 @@ fn a_refused_set_changes_none_of_its_values() {
             .collect();
         assert_eq!(before, after, "rho_inf = {bad}");
     }
+    // the refusal names the value the rules refuse, wherever it stands in the call
+    let err = e
+        .set_reals(&[step, rho, tol], &[2.0, 0.5, 1e-4])
+        .expect_err("max_step = 2 s")
+        .to_string();
+    assert!(
+        err.contains("solver.max_step") && err.contains("at most 1 s"),
+        "{err}"
+    );
     // an unknown reference after good ones: nothing applied either
     assert!(e.set_reals(&[step, 999_999], &[2e-3, 1.0]).is_err());
     assert_eq!(e.get_real(step).unwrap(), before[0]);

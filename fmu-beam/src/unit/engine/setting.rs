@@ -180,26 +180,36 @@ impl Engine {
     }
 
     /// The solver settings of the parameter values with `changes` applied, if the scene's rules
-    /// accept them all (the first value named in a broken rule is the one refused).
+    /// accept them all. A refusal names the first value the rules refuse on its own, or (where
+    /// only the combination breaks a rule) the call's last one.
     fn check_parameters(&self, changes: &[(usize, f64)]) -> Result<Settings, EngineError> {
-        let mut trial = self.values.clone();
-        for &(i, v) in changes {
-            trial[i] = v;
+        let with = |changes: &[(usize, f64)]| {
+            let mut trial = self.values.clone();
+            for &(i, v) in changes {
+                trial[i] = v;
+            }
+            let scene = self.scene_with(&trial);
+            scene.validate("parameters").map(|()| scene)
+        };
+        match with(changes) {
+            Ok(scene) => Ok(Settings::from_scene(&scene)),
+            Err(joint) => {
+                let alone = changes
+                    .iter()
+                    .find_map(|c| with(std::slice::from_ref(c)).err().map(|e| (*c, e)));
+                let &last = changes.last().expect("at least one change");
+                let ((i, value), e) = alone.unwrap_or((last, joint));
+                let rule = match e {
+                    crate::scene::SceneError::Invalid { rule, .. } => rule,
+                    other => other.to_string(),
+                };
+                Err(EngineError::InvalidValue {
+                    name: self.table.variables[i].name.clone(),
+                    value,
+                    rule,
+                })
+            }
         }
-        let scene = self.scene_with(&trial);
-        if let Err(e) = scene.validate("parameters") {
-            let rule = match e {
-                crate::scene::SceneError::Invalid { rule, .. } => rule,
-                other => other.to_string(),
-            };
-            let &(i, value) = changes.last().expect("at least one change");
-            return Err(EngineError::InvalidValue {
-                name: self.table.variables[i].name.clone(),
-                value,
-                rule,
-            });
-        }
-        Ok(Settings::from_scene(&scene))
     }
 
     /// Applies a checked change.
