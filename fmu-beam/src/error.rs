@@ -169,6 +169,19 @@ pub enum EngineError {
         /// The rule it breaks, as the scene's validation states it.
         rule: String,
     },
+    #[error(
+        "{what}: the unit needs about {mebibytes} MiB of memory and the process cannot have it \
+         (reserving it failed: a limit on the address space, strict commit accounting, or too \
+         little memory); make the scene smaller (fewer elements or substructures) or raise the limit"
+    )]
+    /// The memory the scene's unit will hold could not be reserved before building it
+    /// (`unit::memory`): refused instead of aborting the process later.
+    OutOfMemory {
+        /// The call that needed it.
+        what: &'static str,
+        /// What was asked for, with headroom (MiB).
+        mebibytes: u64,
+    },
     #[error("doStep: {message}")]
     /// A doStep call the instance cannot take: not initialized, a step size not positive and
     /// finite, or a communication point other than the instance's time.

@@ -7,6 +7,7 @@ pub(crate) mod axial_load;
 pub(crate) mod effects;
 pub(crate) mod engine;
 pub(crate) mod interface;
+pub(crate) mod memory;
 pub(crate) mod modes;
 pub(crate) mod shape;
 pub(crate) mod variables;

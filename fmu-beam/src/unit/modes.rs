@@ -27,6 +27,7 @@ pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
         ..scene.clone()
     };
     let effects = crate::unit::effects::resolve(scene).effects;
+    crate::unit::memory::ensure_available(scene, "natural frequencies")?;
     let sys = Mechanics::build(scene, &effects);
     let st = initial_state(&sys, 0.0, &settings)?;
     let q = Mechanics::build(&undeformed, &effects).initial_coordinates()?;

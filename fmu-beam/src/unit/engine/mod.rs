@@ -367,6 +367,7 @@ impl Engine {
             let scene = self.scene_with(&self.values);
             scene.validate("parameters")?;
             self.warn_if_auto_would_differ(&scene);
+            crate::unit::memory::ensure_available(&scene, "initialization")?;
             let mut system = Mechanics::build(&scene, &self.effects);
             let settings = Settings::from_scene(&scene);
             for (i, var) in self.table.variables.iter().enumerate() {
