@@ -155,6 +155,33 @@ fn a_symbolic_link_entry_is_refused_and_never_followed() {
     assert!(leftovers(&tmp).is_empty());
 }
 
+/// The model's binary is read before the system's loader sees it: a file that is no shared
+/// library of this platform, or one that does not export the co-simulation entry points, is
+/// refused by name (a real library without them, libm, would load: its code would run).
+#[test]
+fn a_binary_that_is_no_fmu_library_of_this_platform_is_refused_before_loading() {
+    use fmu_harness::platform::{library_header, Platform};
+    let dir = scratch("hostile_binary_kind");
+    let libm = std::fs::read("/lib/x86_64-linux-gnu/libm.so.6").expect("libm, as on every glibc Linux");
+    let cases: [(&str, Vec<u8>, &str); 3] = [
+        ("text.fmu", b"#!/bin/sh\necho hello\n".to_vec(), "not a 64-bit shared library"),
+        ("dll.fmu", library_header(Platform::Win64, 0), "not a 64-bit shared library"),
+        ("libm.fmu", libm, "does not export fmi2Instantiate"),
+    ];
+    for (name, bytes, words) in cases {
+        let fmu = dir.join(name);
+        fmu_of(
+            &fmu,
+            &[
+                ("modelDescription.xml", MD.as_bytes(), false),
+                ("binaries/linux64/m.so", &bytes, false),
+            ],
+        );
+        let run = simulate(&dir, &fmu, &[], QUICK);
+        refused(&run, &["binaries/linux64/m.so", words]);
+    }
+}
+
 #[test]
 fn entries_outside_the_extraction_folder_are_refused() {
     let dir = scratch("hostile_outside");

@@ -196,6 +196,38 @@ pub(super) fn binary_inside(dir: &Path, library: &Path) -> Result<(), SlaveError
     Ok(())
 }
 
+/// The co-simulation entry points a binary must export for the master to load it; the other
+/// functions it calls are looked up after loading ([`crate::fmi2_binding::Api::load`]).
+const ENTRY_POINTS: [&str; 3] = ["fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance"];
+
+/// The model's binary, read before it is loaded: at most
+/// [`crate::engine_library::MAX_LIBRARY_BYTES`], a shared library of the platform this master
+/// runs on (`platform`: ELF x86-64 for linux64, PE32+ AMD64 DLL for win64, from its header)
+/// that exports [`ENTRY_POINTS`] (its symbol table, read with the `object` crate). A file of
+/// another kind is refused here, not handed to the system's loader.
+pub(super) fn binary_loadable(library: &Path, platform: &str) -> Result<(), SlaveError> {
+    let refuse = |reason: &'static str| {
+        SlaveError::from(FmuRefused::Binary {
+            path: library.to_path_buf(),
+            reason,
+        })
+    };
+    let bytes = crate::engine_library::read(library)
+        .map_err(|_| refuse("cannot be read or is larger than 256 MiB"))?;
+    let kind = crate::platform::Platform::of_library(&bytes);
+    let Some(kind) = kind.filter(|k| k.folder() == platform) else {
+        return Err(refuse("is not a 64-bit shared library of this platform (by its header)"));
+    };
+    let missing = crate::engine_library::missing_functions(&bytes, kind)
+        .map_err(|_| refuse("has a symbol table that cannot be read"))?;
+    if missing.iter().any(|f| ENTRY_POINTS.contains(f)) {
+        return Err(refuse(
+            "does not export fmi2Instantiate, fmi2DoStep and fmi2FreeInstance",
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

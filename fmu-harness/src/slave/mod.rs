@@ -242,6 +242,7 @@ impl Slave {
             .join(PLATFORM)
             .join(format!("{}.{LIBRARY_EXTENSION}", md.model_identifier));
         extract::binary_inside(dir, &so)?;
+        extract::binary_loadable(&so, PLATFORM)?;
         let api = Api::load(&so)?;
         Ok((md, api))
     }
