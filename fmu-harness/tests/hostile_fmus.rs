@@ -537,6 +537,25 @@ fn an_absurd_number_of_communication_steps_is_refused_at_once() {
         stderr.contains("step.size") && stderr.contains("at most 1e8"),
         "{stderr}"
     );
+
+    // a variable step whose smallest step could take more than 1e8 steps: refused the same way
+    std::fs::write(
+        &system,
+        format!(
+            "start_time = 0.0\nstop_time = 1.0\n\
+             step = {{ size = 1e-3, variable = {{ min = 1e-300, max = 1e-2, tolerance = 1e-4 }} }}\n\n\
+             [[unit]]\nname = \"c1\"\nfmu = \"{}\"\n",
+            c1.display()
+        ),
+    )
+    .unwrap();
+    let r = harness(&["cosim".as_ref(), system.as_os_str()]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success());
+    assert!(
+        stderr.contains("step.variable.min") && stderr.contains("at most 1e8"),
+        "{stderr}"
+    );
 }
 
 #[test]

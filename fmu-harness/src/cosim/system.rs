@@ -396,6 +396,19 @@ impl System {
                     format!("= {}: must be non-negative", v.abs_tolerance),
                 ));
             }
+            // the controller never steps below `min`: the count's worst case, bounded as the
+            // fixed step's count is
+            let worst = ((self.stop_time - self.start_time) / v.min).ceil();
+            if worst.is_nan() || worst > limit {
+                return Err(bad(
+                    "step.variable.min",
+                    format!(
+                        "= {:e}: up to {worst:.3e} communication steps from start_time to \
+                         stop_time; the master takes at most {limit:e}",
+                        v.min
+                    ),
+                ));
+            }
             if !(v.min <= self.step.size && self.step.size <= v.max) {
                 return Err(bad(
                     "step.size",
