@@ -78,7 +78,9 @@ pub enum Command {
         /// Variables to record [default: every output].
         #[arg(long, value_delimiter = ',')]
         output: Vec<String>,
-        /// The CSV file to write [default: standard output].
+        /// The CSV file to write, whole or not at all [default: standard output, row by row:
+        /// a run that fails keeps the rows already written and exits non-zero, the reason on
+        /// standard error].
         #[arg(short = 'o', long = "csv")]
         csv: Option<PathBuf>,
     },
@@ -88,7 +90,9 @@ pub enum Command {
     Cosim {
         /// The system file (TOML); FMU paths in it are relative to it.
         system: PathBuf,
-        /// The CSV file to write [default: standard output, summary on standard error].
+        /// The CSV file to write, whole or not at all [default: standard output, row by row,
+        /// summary on standard error; a run that fails keeps the rows already written and exits
+        /// non-zero].
         #[arg(short = 'o', long = "csv")]
         csv: Option<PathBuf>,
     },
