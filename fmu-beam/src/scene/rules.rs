@@ -173,6 +173,142 @@ pub(crate) const FINITE: Rule = rule(
     Any,
     Schema::None,
 );
+/// A [`RANGES`] rule.
+pub(crate) const GRAVITY_RANGE: Rule = rule(
+    "gravity_range",
+    &["world.gravity[]"],
+    "must be at most 1e4 m/s² in magnitude (1000 g)",
+    Any,
+    Schema::Within(-1e4, 1e4),
+);
+/// A [`RANGES`] rule.
+pub(crate) const LENGTH_RANGE: Rule = rule(
+    "length_range",
+    &[
+        "beam[].length",
+        "beam[].position[]",
+        "beam[].section.a",
+        "beam[].section.b",
+        "beam[].section.d",
+        "beam[].section.t",
+        "beam[].initial.tip_displacement",
+        "body[].position[]",
+        "body[].com[]",
+        "body[].frames.<name>[]",
+    ],
+    "must be at most 1e4 m in magnitude (10 km)",
+    Any,
+    Schema::Within(-1e4, 1e4),
+);
+/// A [`RANGES`] rule.
+pub(crate) const MODULUS_RANGE: Rule = rule(
+    "modulus_range",
+    &[
+        "beam[].material.E",
+        "beam[].material.G",
+    ],
+    "must be at most 1e13 Pa (ten times diamond's modulus)",
+    Any,
+    Schema::Within(-1e13, 1e13),
+);
+/// A [`RANGES`] rule.
+pub(crate) const DENSITY_RANGE: Rule = rule(
+    "density_range",
+    &[
+        "beam[].material.rho",
+    ],
+    "must be at most 1e5 kg/m³ (four times osmium's density)",
+    Any,
+    Schema::Within(-1e5, 1e5),
+);
+/// A [`RANGES`] rule.
+pub(crate) const MASS_RANGE: Rule = rule(
+    "mass_range",
+    &[
+        "body[].mass",
+    ],
+    "must be at most 1e9 kg",
+    Any,
+    Schema::Within(-1e9, 1e9),
+);
+/// A [`RANGES`] rule.
+pub(crate) const INERTIA_RANGE: Rule = rule(
+    "inertia_range",
+    &[
+        "body[].inertia[]",
+    ],
+    "must be at most 1e12 kg·m²",
+    Any,
+    Schema::Within(-1e12, 1e12),
+);
+/// A [`RANGES`] rule.
+pub(crate) const LOAD_RANGE: Rule = rule(
+    "load_range",
+    &[
+        "load[].force[]",
+        "load[].torque[]",
+    ],
+    "must be at most 1e12 N (a torque: N·m) in magnitude",
+    Any,
+    Schema::Within(-1e12, 1e12),
+);
+/// A [`RANGES`] rule.
+pub(crate) const LAW_VALUE_RANGE: Rule = rule(
+    "law_value_range",
+    &[
+        "joint[].drive.value",
+        "joint[].drive.omega",
+        "joint[].drive.table[][1]",
+        "load[].scale.value",
+        "load[].scale.table[][1]",
+    ],
+    "must be at most 1e12 in magnitude, in the unit of what the law drives or scales",
+    Any,
+    Schema::Within(-1e12, 1e12),
+);
+/// A [`RANGES`] rule.
+pub(crate) const TIME_RANGE: Rule = rule(
+    "time_range",
+    &[
+        "experiment.start_time",
+        "experiment.stop_time",
+        "joint[].drive.time_constant",
+        "joint[].drive.ramp_time",
+        "joint[].drive.until",
+        "joint[].drive.table[][0]",
+        "load[].scale.time_constant",
+        "load[].scale.ramp_time",
+        "load[].scale.until",
+        "load[].scale.table[][0]",
+    ],
+    "must be at most 1e9 s in magnitude (32 years)",
+    Any,
+    Schema::Within(-1e9, 1e9),
+);
+/// The physical ranges, with each rule's bound: every number of these fields lies within
+/// ±bound, far beyond any machine's figure. A larger value describes no machine and only makes
+/// the integrator take steps without end (gravity of 1e9 m/s² and an effort drive of −9.2e18
+/// N·m kept `Stepper::advance` busy for minutes). A test checks each rule's text and schema
+/// against its bound.
+pub const RANGES: &[(Rule, f64)] = &[
+    (GRAVITY_RANGE, 1e4),
+    (LENGTH_RANGE, 1e4),
+    (MODULUS_RANGE, 1e13),
+    (DENSITY_RANGE, 1e5),
+    (MASS_RANGE, 1e9),
+    (INERTIA_RANGE, 1e12),
+    (LOAD_RANGE, 1e12),
+    (LAW_VALUE_RANGE, 1e12),
+    (TIME_RANGE, 1e9),
+];
+
+/// The range rule and bound of the quantity at `field`, if it has one.
+pub fn range_of(field: &str) -> Option<&'static (Rule, f64)> {
+    RANGES
+        .iter()
+        .find(|(r, _)| r.fields.iter().any(|p| field_matches(p, field)))
+}
+
 pub(crate) const POSITIVE: Rule = rule(
     "positive",
     &[
@@ -852,6 +988,15 @@ pub(crate) const SPATIAL_EFFECTS: Rule = rule(
 /// Every rule, in the order the reference lists them.
 pub const RULES: &[Rule] = &[
     FINITE,
+    GRAVITY_RANGE,
+    LENGTH_RANGE,
+    MODULUS_RANGE,
+    DENSITY_RANGE,
+    MASS_RANGE,
+    INERTIA_RANGE,
+    LOAD_RANGE,
+    LAW_VALUE_RANGE,
+    TIME_RANGE,
     POSITIVE,
     NON_NEGATIVE,
     SCENE_NAME,
@@ -1038,6 +1183,27 @@ mod tests {
         quotes(&BEAM_ELEMENTS_MAX, &format!("at most {MAX_BEAM_ELEMENTS}"));
         quotes(&UNIT_MEMORY, &format!("({MAX_UNIT_MEMORY} bytes"));
         quotes(&VARIABLES_MAX, &format!("at most {MAX_VARIABLES} FMU"));
+    }
+
+    #[test]
+    fn each_range_rule_quotes_its_bound_in_its_text_and_schema() {
+        for (rule, bound) in RANGES {
+            assert!(
+                rule.text.contains(&format!("at most {bound:e}")),
+                "{}: {}",
+                rule.code,
+                rule.text
+            );
+            assert_eq!(rule.schema, Schema::Within(-bound, *bound), "{}", rule.code);
+            assert!(RULES.contains(rule), "{}", rule.code);
+        }
+        assert_eq!(range_of("world.gravity[1]").map(|r| r.1), Some(1e4));
+        assert_eq!(range_of("body[3].frames.tip[0]").map(|r| r.1), Some(1e4));
+        assert_eq!(
+            range_of("joint[0].drive.table[2][0]").map(|r| r.0.code),
+            Some("time_range")
+        );
+        assert_eq!(range_of("solver.rho_inf"), None);
     }
 
     #[test]

@@ -88,11 +88,14 @@ impl Checker<'_> {
         }
     }
 
+    /// A finite number, within its quantity's range where it has one ([`r::RANGES`]).
     pub(super) fn finite(&self, field: &str, v: f64) -> Result<(), SceneError> {
-        if v.is_finite() {
-            Ok(())
-        } else {
-            Err(self.fail(&r::FINITE, field, v))
+        if !v.is_finite() {
+            return Err(self.fail(&r::FINITE, field, v));
+        }
+        match r::range_of(field) {
+            Some((rule, bound)) if v.abs() > *bound => Err(self.fail(rule, field, v)),
+            _ => Ok(()),
         }
     }
 
