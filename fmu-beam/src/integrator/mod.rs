@@ -39,9 +39,9 @@ pub struct Settings {
 }
 
 /// The default work budget of a communication step: at about 15 µs a step of a small scene
-/// (the pendulum), 15 s of work. A communication step that needs more (a force of 1e18 N,
-/// gravity of 1e9 m/s², a doStep of 1e6 s) ends in a Discard instead of running for hours;
-/// `solver.step_budget` sets it.
+/// (the pendulum), 15 s of work. A communication step that needs more (a doStep of 1e6 s; a
+/// force of 1e18 N or gravity of 1e9 m/s² did, which the scene's ranges now refuse) ends in a
+/// Discard instead of running for hours; `solver.step_budget` sets it.
 pub const DEFAULT_STEP_BUDGET: u64 = 1_000_000;
 
 impl Settings {
