@@ -67,6 +67,9 @@ pub enum HarnessError {
     MatrixFile(#[from] fmu_beam::scene::matrix_file::MatrixFileError),
     #[error(transparent)]
     Simulate(#[from] crate::simulate::SimulateError),
+    /// `simulate`: the FMU ended the run before the stop time (its rows are written); exit 3.
+    #[error("{0}")]
+    Ended(Box<crate::simulate::Ended>),
     #[error(transparent)]
     Cosim(#[from] crate::cosim::CosimError),
     #[error(transparent)]
@@ -129,6 +132,7 @@ impl HarnessError {
     pub fn exit_code(&self) -> i32 {
         match self {
             HarnessError::Scene(_) => 2,
+            HarnessError::Ended(_) => 3,
             _ => 1,
         }
     }
