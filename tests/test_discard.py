@@ -175,3 +175,46 @@ def test_the_masters_tolerance_is_used_and_a_looser_one_is_warned_about(fmu_dir)
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+def test_cosim_ends_cleanly_where_a_unit_ends_the_simulation(harness, spin_up, tmp_path):
+    for rollback in ("", "[rollback]\nmax_halvings = 4\n"):
+        system = tmp_path / "system.toml"
+        system.write_text(f"""stop_time = 20.0
+step = {{ size = 0.01 }}
+outputs = ["spin.beam.tip.x"]
+{rollback}
+[[unit]]
+name = "spin"
+fmu = "{spin_up}"
+""")
+        csv = tmp_path / "run.csv"
+        r = run_harness(harness, "cosim", system, "-o", csv)
+        assert r.returncode == 3, r.stderr
+        said = r.stdout + r.stderr
+        assert "unit `spin` ended the simulation at t = 4.43 s" in said, said
+        assert "more than 1 % beyond its length" in said
+        assert "0 rollbacks" in said, "no retry of a unit that ended the simulation"
+        rows = np.loadtxt(csv, delimiter=",", skiprows=1)
+        assert rows[-1, 0] == pytest.approx(SPIN_UP_END, abs=1e-9)
+
+
+def test_the_harness_master_retries_a_discarded_step_in_halves(harness, root, tmp_path):
+    # C1 with a work budget of one internal step: each 1 ms step (two of 0.5 ms) is discarded,
+    # and passes in halves; a unit without inputs steps across communication points, so the
+    # rows are those of the C1 run without a budget, bit for bit
+    text = (root / "scenes" / f"{C1}.toml").read_text()
+    assert "\n[solver]\n" in text
+    scene = tmp_path / f"{C1}.toml"
+    scene.write_text(text.replace("\n[solver]\n", "\n[solver]\nstep_budget = 1\n", 1))
+    budget, plain = tmp_path / "budget.fmu", tmp_path / "plain.fmu"
+    for src, fmu in ((scene, budget), (root / "scenes" / f"{C1}.toml", plain)):
+        r = run_harness(harness, "package", src, "-o", fmu)
+        assert r.returncode == 0, r.stderr
+    runs = {}
+    for fmu in (budget, plain):
+        r = run_harness(harness, "simulate", fmu, "--stop", "0.01", "--csv", tmp_path / f"{fmu.stem}.csv")
+        assert r.returncode == 0, r.stderr
+        runs[fmu.stem] = (tmp_path / f"{fmu.stem}.csv").read_text()
+    assert runs["budget"] == runs["plain"]
+    assert len(runs["plain"].splitlines()) == 12

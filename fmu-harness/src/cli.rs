@@ -201,6 +201,11 @@ fn simulate_cmd(
     }
 }
 
+/// A run a unit ended early is written, then reported with exit status 3.
+fn ended(why: Option<String>) -> Result<(), HarnessError> {
+    why.map_or(Ok(()), |e| Err(HarnessError::CosimEnded(e)))
+}
+
 /// `cosim`: runs the system; the CSV streams to `csv` (summary to `out`) or to `out` (summary
 /// to standard error), a file through a temporary sibling as in `simulate`.
 fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(), HarnessError> {
@@ -209,14 +214,15 @@ fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(
             let summary = write_csv_through_temporary(path, |sink| {
                 cosim::cosim_into(system, sink).map_err(HarnessError::from)
             })?;
-            writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)
+            writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)?;
+            ended(summary.ended)
         }
         None => {
             let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(&mut *out));
             let summary = cosim::cosim_into(system, &mut writer)?;
             writer.into_inner().flush().map_err(stdout_err)?;
             eprint!("{}", summary.text());
-            Ok(())
+            ended(summary.ended)
         }
     }
 }

@@ -338,15 +338,19 @@ impl Slave {
     }
 
     /// fmi2GetBooleanStatus(fmi2Terminated): whether the FMU asks to end the simulation (after
-    /// a Discard); false when the FMU does not export the function.
+    /// a Discard). False when the FMU does not export the function or does not answer it
+    /// (fmi2Error, as an FMU that never ends a simulation may); what it logged then is dropped.
     pub fn terminated(&mut self) -> Result<bool, SlaveError> {
         const F: &str = "fmi2GetBooleanStatus";
         match self
             .live(F)?
             .get_boolean_status(fmi2_binding::fmi2Terminated)
         {
-            Ok((s, value)) => self.check(F, s).map(|_| value),
-            Err(Refusal::NotExported(_)) => Ok(false),
+            Ok((s, value)) if s.is_success() => Ok(value),
+            Ok(_) | Err(Refusal::NotExported(_)) => {
+                let _ = self.take_messages();
+                Ok(false)
+            }
             Err(r) => Err(Self::refused(F, r)),
         }
     }
