@@ -154,3 +154,38 @@ def test_split_converges_to_the_monolithic_unit(fmu_dir):
         assert t1 < 0.67 * t0, errors
         assert s1 < 0.67 * s0, errors
     assert errors[-1][1] < 0.01 * 4.9e-3, errors
+
+
+def test_gauss_seidel_linear_equals_held_where_one_rod_step_spans_each_communication_step(
+        fmu_dir, harness, tmp_path):
+    """Issue 31: with the 20x crank at h = 1 ms, Gauss-Seidel "linear" gives the CSV of "held".
+    Not a bug: the rod takes one internal step per communication step, and its index-3
+    generalized-alpha step meets the motion drive's position at the step's end only, which both
+    schemes set to the crank tip's new position; the linear scheme's rate changes nothing there
+    (its second derivative, zero, is what a quadratic one changes). With four internal steps per
+    communication step the rod sees the positions in between, and the two differ: held fails,
+    linear runs."""
+    import study
+
+    rod = str(study.FMUS.resolve() / "slider_crank_split_rod.fmu")
+
+    def run(extrapolation, rod_max_step=None):
+        text = study.system_text(1e-3, 0.05, "gauss-seidel", extrapolation, 55400.0)
+        text = text.replace('"rod.slider.position"]', '"rod.slider.position", "rod.solver.steps"]')
+        if rod_max_step:
+            text = text.replace(f'fmu = "{rod}"', f'fmu = "{rod}"\nstart = {{ "solver.max_step" = {rod_max_step!r} }}')
+        system, out = tmp_path / f"{extrapolation}.toml", tmp_path / f"{extrapolation}.csv"
+        system.write_text(text)
+        r = subprocess.run([harness, "cosim", system, "-o", out], capture_output=True, text=True)
+        return (out.read_bytes() if r.returncode == 0 else None), r.stderr
+
+    held, e = run("none")
+    linear, _ = run("linear")
+    assert held is not None and held == linear, e
+    names, rows = read_csv(tmp_path / "linear.csv")
+    steps = rows[:, names.index("rod.solver.steps")]
+    assert steps[-1] == 50, "one internal step of the rod per communication step"
+    held, e = run("none", 2.5e-4)
+    linear, e_linear = run("linear", 2.5e-4)
+    assert linear is not None, e_linear
+    assert held is None and "fmi2Discard" in e, e

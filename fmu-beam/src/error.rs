@@ -240,6 +240,19 @@ impl EngineError {
     }
 }
 
+impl EngineError {
+    /// True for the failures after which no step from the last good state can succeed: the
+    /// validity monitor found the model out of its range (a frame that ran away, a beam
+    /// stretched). A smaller step only reaches the same end sooner, so the unit asks the master
+    /// to end the simulation (fmi2Terminated) instead of inviting a retry.
+    pub fn ends_run(&self) -> bool {
+        matches!(
+            self,
+            EngineError::Runaway { .. } | EngineError::Stretched { .. }
+        )
+    }
+}
+
 impl From<SceneError> for EngineError {
     fn from(e: SceneError) -> Self {
         EngineError::Scene(Box::new(e))

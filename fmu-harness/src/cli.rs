@@ -187,16 +187,27 @@ fn simulate_cmd(
         step,
         outputs,
     };
-    match csv {
+    let ended = match csv {
         Some(path) => write_csv_through_temporary(path, |sink| {
             simulate::simulate_into(fmu, &options, sink).map_err(HarnessError::from)
-        }),
+        })?,
         None => {
             let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(out));
-            simulate::simulate_into(fmu, &options, &mut writer)?;
-            writer.into_inner().flush().map_err(stdout_err)
+            let ended = simulate::simulate_into(fmu, &options, &mut writer)?;
+            writer.into_inner().flush().map_err(stdout_err)?;
+            ended
         }
+    };
+    // The CSV is written, up to the last good time; the status tells a script it ended early.
+    match ended {
+        Some(ended) => Err(HarnessError::Ended(Box::new(ended))),
+        None => Ok(()),
     }
+}
+
+/// A run a unit ended early is written, then reported with exit status 3.
+fn ended(why: Option<String>) -> Result<(), HarnessError> {
+    why.map_or(Ok(()), |e| Err(HarnessError::CosimEnded(e)))
 }
 
 /// `cosim`: runs the system; the CSV streams to `csv` (summary to `out`) or to `out` (summary
@@ -207,14 +218,15 @@ fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(
             let summary = write_csv_through_temporary(path, |sink| {
                 cosim::cosim_into(system, sink).map_err(HarnessError::from)
             })?;
-            writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)
+            writeln!(out, "{}wrote {}", summary.text(), path.display()).map_err(stdout_err)?;
+            ended(summary.ended)
         }
         None => {
             let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(&mut *out));
             let summary = cosim::cosim_into(system, &mut writer)?;
             writer.into_inner().flush().map_err(stdout_err)?;
             eprint!("{}", summary.text());
-            Ok(())
+            ended(summary.ended)
         }
     }
 }
@@ -249,13 +261,71 @@ fn write_csv_through_temporary<T>(
     Ok(value)
 }
 
+/// The page and the GIF that `animate` writes: `-o` by its extension (.html or .htm a page,
+/// .gif a GIF), `--gif` a GIF (.gif); any other extension is refused before the run is made,
+/// rather than writing one format under another's name.
+fn animation_files(
+    output: Option<PathBuf>,
+    gif: Option<PathBuf>,
+) -> Result<(Option<PathBuf>, Option<PathBuf>), HarnessError> {
+    let extension = |p: &Path| {
+        p.extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default()
+    };
+    let refuse = |name, path: &Path, rule| -> HarnessError {
+        animate::AnimateError::BadOption {
+            name,
+            value: path.display().to_string(),
+            rule,
+        }
+        .into()
+    };
+    if let Some(g) = &gif {
+        if extension(g) != "gif" {
+            return Err(refuse("--gif", g, "the GIF's name ends in .gif"));
+        }
+    }
+    let (html, gif) =
+        match output {
+            None => (None, gif),
+            Some(o) => match extension(&o).as_str() {
+                "html" | "htm" => (Some(o), gif),
+                "gif" if gif.is_none() => (None, Some(o)),
+                "gif" => {
+                    return Err(refuse(
+                        "-o",
+                        &o,
+                        "a .gif, and --gif names a GIF too: give one",
+                    ))
+                }
+                _ => return Err(refuse(
+                    "-o",
+                    &o,
+                    "the format comes from the extension: .html (or .htm) for the page, .gif for \
+                     the GIF; no other format is written",
+                )),
+            },
+        };
+    if html.is_none() && gif.is_none() {
+        return Err(animate::AnimateError::BadOption {
+            name: "--output/--gif",
+            value: "none".into(),
+            rule: "give the page (-o run.html), the GIF (-o run.gif or --gif run.gif) or both",
+        }
+        .into());
+    }
+    Ok((html, gif))
+}
+
 /// The options of `animate`.
 #[derive(Debug, clap::Args)]
 pub struct AnimateArgs {
     /// The run: a CSV of `simulate` or `cosim`, an FMU (run here with its
     /// DefaultExperiment), or a scene file (run directly by the engine).
     run: PathBuf,
-    /// The page to write (.html).
+    /// The file to write, its format from its extension: .html (or .htm) the page, .gif the
+    /// GIF; any other is refused.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// The animated GIF to write.
@@ -310,6 +380,7 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
         metadata,
     } = args;
     let (width, height) = parse_size(&size)?;
+    let (output, gif) = animation_files(output, gif)?;
     let started = std::time::Instant::now();
     let mut scenes: Vec<animate::KnownScene> = scene
         .iter()
@@ -320,14 +391,6 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
     if let Some(path) = &csv {
         std::fs::write(path, recording.csv())
             .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
-    }
-    if output.is_none() && gif.is_none() {
-        return Err(animate::AnimateError::BadOption {
-            name: "--output/--gif",
-            value: "none".into(),
-            rule: "give the page (-o run.html), the GIF (--gif run.gif) or both",
-        }
-        .into());
     }
     let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
     let options = animate::Options {

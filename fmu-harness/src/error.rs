@@ -67,6 +67,13 @@ pub enum HarnessError {
     MatrixFile(#[from] fmu_beam::scene::matrix_file::MatrixFileError),
     #[error(transparent)]
     Simulate(#[from] crate::simulate::SimulateError),
+    /// `simulate`: the FMU ended the run before the stop time (its rows are written); exit 3.
+    #[error("{0}")]
+    Ended(Box<crate::simulate::Ended>),
+    /// `cosim`: a unit ended the run before the stop time (the rows up to then are written);
+    /// exit 3.
+    #[error("{0}")]
+    CosimEnded(String),
     #[error(transparent)]
     Cosim(#[from] crate::cosim::CosimError),
     #[error(transparent)]
@@ -125,10 +132,13 @@ fn binary_platform_message(named: Option<Platform>, found: Option<Platform>) -> 
 }
 
 impl HarnessError {
-    /// Process exit status: 2 for a refused scene (an error of input), 1 for anything else.
+    /// Process exit status: 2 for a refused scene (an error of input), 3 for a run that a unit
+    /// ended before the stop time (fmi2Discard with fmi2Terminated; its rows are written), 1 for
+    /// anything else.
     pub fn exit_code(&self) -> i32 {
         match self {
             HarnessError::Scene(_) => 2,
+            HarnessError::Ended(_) | HarnessError::CosimEnded(_) => 3,
             _ => 1,
         }
     }

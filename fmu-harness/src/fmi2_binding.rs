@@ -11,6 +11,9 @@
 //! array lengths passed to C are the slice lengths; an [`FmuState`] is only ever handed back to
 //! the instance that made it.
 //!
+//! Over 600 lines: the binding mirrors the C API one function to one method, and splitting
+//! it would spread the unsafe code that this one file is meant to hold.
+//!
 //! Over 600 lines on purpose: all of the crate's unsafe code, in one file to be reviewed as one.
 
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
@@ -18,8 +21,9 @@
 pub use fmu_beam::fmi2_types::{
     fmi2Boolean, fmi2CallbackAllocateMemory, fmi2CallbackFreeMemory, fmi2CoSimulation,
     fmi2Component, fmi2ComponentEnvironment, fmi2FMUstate, fmi2False, fmi2Integer, fmi2Real,
-    fmi2StepFinished, fmi2String, fmi2True, fmi2Type, fmi2ValueReference,
+    fmi2StatusKind, fmi2StepFinished, fmi2String, fmi2True, fmi2Type, fmi2ValueReference,
 };
+pub use fmu_beam::fmi2_types::{fmi2LastSuccessfulTime, fmi2Terminated};
 use std::ffi::CStr;
 use std::os::raw::{c_int, c_void};
 use std::path::Path;
@@ -32,10 +36,11 @@ pub type RawStatus = c_int;
 
 /// `fmi2CallbackLogger` without its variadic tail. C declares it `(env, name, status, category,
 /// message, ...)`; a stable Rust `extern "C" fn` cannot be variadic, so the master's logger takes
-/// the fixed arguments only and `message` is shown as it comes. Our FMUs double every `%`, so
-/// their messages carry no directives; a foreign FMU's printf-style arguments are not expanded
-/// (the message keeps its `%d`, `%s`, ...). Hence the master's own logger type and callback
-/// struct, of the same layout as [`fmu_beam::fmi2_types::fmi2CallbackFunctions`] (checked below).
+/// the fixed arguments only and formats `message` without them ([`crate::log_format::printf`]):
+/// `%%` becomes `%`, as every importer prints it; a directive that would read an argument (a
+/// foreign FMU's `%d`, `%s`, ...) is kept as it is written. Hence the master's own logger type
+/// and callback struct, of the same layout as [`fmu_beam::fmi2_types::fmi2CallbackFunctions`]
+/// (checked below).
 pub type fmi2CallbackLogger =
     unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, RawStatus, fmi2String, fmi2String);
 
@@ -142,6 +147,10 @@ pub type fmi2GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
 ) -> RawStatus;
 pub type fmi2DoStepTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> RawStatus;
+pub type fmi2GetRealStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Real) -> RawStatus;
+pub type fmi2GetBooleanStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Boolean) -> RawStatus;
 
 extern "C" {
     fn calloc(nobj: usize, size: usize) -> *mut c_void;
@@ -238,7 +247,7 @@ unsafe extern "C" fn log_message(
         let entry = LogMessage {
             status: Status::from_c(status),
             category: text(category),
-            message: text(message),
+            message: crate::log_format::printf(&text(message)),
         };
         if let Ok(mut v) = sink.lock() {
             v.push(entry);
@@ -289,6 +298,8 @@ pub struct Api {
     free_fmu_state: Option<fmi2FreeFMUstateTYPE>,
     set_real_input_derivatives: Option<fmi2SetRealInputDerivativesTYPE>,
     get_directional_derivative: Option<fmi2GetDirectionalDerivativeTYPE>,
+    get_real_status: Option<fmi2GetRealStatusTYPE>,
+    get_boolean_status: Option<fmi2GetBooleanStatusTYPE>,
     // Last: the function pointers above are only valid while the library is loaded.
     _library: libloading::Library,
 }
@@ -354,6 +365,8 @@ impl Api {
                 "fmi2GetDirectionalDerivative",
                 fmi2GetDirectionalDerivativeTYPE
             ),
+            get_real_status: optional!("fmi2GetRealStatus", fmi2GetRealStatusTYPE),
+            get_boolean_status: optional!("fmi2GetBooleanStatus", fmi2GetBooleanStatusTYPE),
             _library: library,
         }))
     }
@@ -490,6 +503,30 @@ impl Instance {
         Status::from_c(unsafe {
             (self.api.do_step)(self.component, t, h, no_set_fmu_state_prior as fmi2Boolean)
         })
+    }
+
+    /// `fmi2GetRealStatus(kind)`: the status and the value.
+    pub fn get_real_status(&mut self, kind: fmi2StatusKind) -> Result<(Status, f64), Refusal> {
+        let f = self
+            .api
+            .get_real_status
+            .ok_or(Refusal::NotExported("fmi2GetRealStatus"))?;
+        let mut value = f64::NAN;
+        // SAFETY: a live component and a valid pointer for the call.
+        let s = Status::from_c(unsafe { f(self.component, kind, &mut value) });
+        Ok((s, value))
+    }
+
+    /// `fmi2GetBooleanStatus(kind)`: the status and the value.
+    pub fn get_boolean_status(&mut self, kind: fmi2StatusKind) -> Result<(Status, bool), Refusal> {
+        let f = self
+            .api
+            .get_boolean_status
+            .ok_or(Refusal::NotExported("fmi2GetBooleanStatus"))?;
+        let mut value: fmi2Boolean = fmi2False;
+        // SAFETY: a live component and a valid pointer for the call.
+        let s = Status::from_c(unsafe { f(self.component, kind, &mut value) });
+        Ok((s, value != fmi2False))
     }
 
     /// `fmi2GetReal`; panics if the slices differ in length (a bug of the caller).

@@ -17,6 +17,7 @@ pub mod fmi2_binding;
 pub mod guid;
 pub mod input_file;
 pub mod log_categories;
+pub mod log_format;
 pub mod model_description;
 pub mod modes;
 pub mod package;

@@ -36,7 +36,7 @@ pub fn render(scene: &Scene, table: &VariableTable, guid: &str) -> Result<String
     }
     let units = unit_definitions(&defined)?;
     let categories = log_categories()?;
-    let experiment = default_experiment(&scene.experiment)?;
+    let experiment = default_experiment(&scene.experiment, scene.solver.tolerance)?;
     let variables = model_variables(table)?;
     let structure = model_structure(table)?;
     fill(
@@ -105,16 +105,25 @@ pub fn log_categories() -> Result<String, HarnessError> {
     x.finish()
 }
 
-pub fn default_experiment(e: &ExperimentSpec) -> Result<String, HarnessError> {
-    let (t0, t1, h) = (
+/// `<DefaultExperiment>`: the scene's times and communication step, and its solver tolerance,
+/// so that a master which passes the DefaultExperiment's tolerance to fmi2SetupExperiment runs
+/// the unit at the scene's (issue 31).
+pub fn default_experiment(e: &ExperimentSpec, tolerance: f64) -> Result<String, HarnessError> {
+    let (t0, t1, tol, h) = (
         format_real(e.start_time),
         format_real(e.stop_time),
+        format_real(tolerance),
         format_real(e.step_size),
     );
     let mut x = Xml::new();
     x.empty(
         "DefaultExperiment",
-        &[("startTime", &t0), ("stopTime", &t1), ("stepSize", &h)],
+        &[
+            ("startTime", &t0),
+            ("stopTime", &t1),
+            ("tolerance", &tol),
+            ("stepSize", &h),
+        ],
     )?;
     x.finish()
 }

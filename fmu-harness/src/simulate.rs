@@ -6,11 +6,19 @@
 //! start + (n+1)·h, the last step shortened to land on the stop time, the run ends when t is
 //! within 1e-9 relative of the stop time.
 //!
+//! fmi2Discard (FMI 2.0 §4.2.3): when the FMU says it cannot go on (fmi2Terminated), the run
+//! ends cleanly at its last good time (fmi2LastSuccessfulTime), recorded as the last row, and
+//! [`simulate_into`] returns [`Ended`] with the FMU's messages (`fmu-harness simulate` exits
+//! with status 3). Otherwise the step is retried from the last good time in halves, at most
+//! [`MAX_HALVINGS`] times, before the run fails. Here the master differs from fmpy, which
+//! retries with the same step.
+//!
 //! Rows go to a [`RowSink`] as they are recorded: the command line streams them to the CSV
 //! ([`CsvWriter`]), so a long run holds one row in memory, not all of them; [`simulate`] keeps
 //! them ([`Results`]). A run is refused before it starts when it would take more than
 //! [`MAX_COMMUNICATION_STEPS`] steps (a `stepSize="1e-300"` of a hostile FMU).
 
+use crate::fmi2_binding::{LogMessage, Status};
 use crate::slave::{Slave, SlaveError, VarType, Variable};
 use std::io::Write;
 use std::path::Path;
@@ -18,6 +26,36 @@ use std::path::Path;
 /// Communication steps of one run: 1e8 (a day at 1 ms is 8.6e7). More is refused as absurd
 /// before the FMU is instantiated.
 pub const MAX_COMMUNICATION_STEPS: f64 = 1e8;
+
+/// Halvings of a communication step that an FMU discarded without ending the simulation:
+/// 10, a step down to 1/1024 of the communication step.
+pub const MAX_HALVINGS: u32 = 10;
+
+/// A run that the FMU ended before the stop time (fmi2Discard, then fmi2Terminated = true).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ended {
+    /// The FMU's last good time, the last row's (s).
+    pub time: f64,
+    /// The stop time the run was to reach (s).
+    pub stop: f64,
+    /// What the FMU logged about it.
+    pub messages: Vec<String>,
+}
+
+impl std::fmt::Display for Ended {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the FMU ended the simulation at t = {} s of {} s (fmi2Discard, fmi2Terminated); \
+             every row up to that time is recorded",
+            self.time, self.stop
+        )?;
+        for m in &self.messages {
+            write!(f, "\n  {m}")?;
+        }
+        Ok(())
+    }
+}
 
 /// Where recorded rows go, one at a time: first the columns, then each row (time first).
 pub trait RowSink {
@@ -171,24 +209,25 @@ pub enum SimulateError {
     Output(#[source] std::io::Error),
 }
 
-/// Runs the FMU from start to stop with communication step `step`, keeping every row.
-pub fn simulate(fmu: &Path, options: &Options) -> Result<Results, SimulateError> {
+/// Runs the FMU from start to stop with communication step `step`, keeping every row; with
+/// [`Ended`] where the FMU ended the run before the stop time.
+pub fn simulate(fmu: &Path, options: &Options) -> Result<(Results, Option<Ended>), SimulateError> {
     let mut results = Results {
         columns: Vec::new(),
         types: Vec::new(),
         rows: Vec::new(),
     };
-    simulate_into(fmu, options, &mut results)?;
-    Ok(results)
+    let ended = simulate_into(fmu, options, &mut results)?;
+    Ok((results, ended))
 }
 
 /// Runs the FMU from start to stop with communication step `step`, each row to `sink` as soon
-/// as it is recorded.
+/// as it is recorded; `Some(Ended)` where the FMU ended the run early.
 pub fn simulate_into(
     fmu: &Path,
     options: &Options,
     sink: &mut dyn RowSink,
-) -> Result<(), SimulateError> {
+) -> Result<Option<Ended>, SimulateError> {
     let mut slave = Slave::load(fmu)?;
     let md = slave.model_description.clone();
     let de = md.default_experiment;
@@ -243,12 +282,66 @@ pub fn simulate_into(
         if next > stop && !is_close(next, stop) {
             next = stop;
         }
-        slave.do_step(t, next - t, true)?;
+        if let Some((end, messages)) = advance(&mut slave, t, next)? {
+            if end > t {
+                sink.row(&record(&mut slave, end, &vars)?)
+                    .map_err(SimulateError::Output)?;
+            }
+            slave.terminate()?;
+            return Ok(Some(Ended {
+                time: end,
+                stop,
+                messages: messages.iter().map(|m| m.message.clone()).collect(),
+            }));
+        }
         t = next;
         n += 1;
         sink.row(&record(&mut slave, t, &vars)?)
             .map_err(SimulateError::Output)?;
     }
     slave.terminate()?;
-    Ok(())
+    Ok(None)
+}
+
+/// Steps the slave from `t` to `next`; a Discard is retried from the last good time with half
+/// the step, up to [`MAX_HALVINGS`] times. `Some(last good time)` when the FMU ended the
+/// simulation (fmi2Terminated), with what it logged.
+fn advance(
+    slave: &mut Slave,
+    t: f64,
+    next: f64,
+) -> Result<Option<(f64, Vec<LogMessage>)>, SimulateError> {
+    let (mut at, mut h, mut halvings) = (t, next - t, 0);
+    while !is_close(at, next) && at < next {
+        let h_now = if is_close(at + h, next) || at + h > next {
+            next - at
+        } else {
+            h
+        };
+        match slave.do_step(at, h_now, true) {
+            Ok(_) => at += h_now,
+            Err(SlaveError::Call {
+                status: Status::Discard,
+                messages,
+                ..
+            }) => {
+                if slave.terminated()? {
+                    let end = slave.last_successful_time()?;
+                    return Ok(Some((end, messages)));
+                }
+                if halvings == MAX_HALVINGS {
+                    return Err(SimulateError::Slave(SlaveError::Call {
+                        function: "fmi2DoStep",
+                        status: Status::Discard,
+                        messages,
+                    }));
+                }
+                at = slave.last_successful_time()?;
+                h = h_now / 2.0;
+                halvings += 1;
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    Ok(None)
 }

@@ -119,7 +119,7 @@ fn pair_error(r: &Results) -> f64 {
 fn simulate_runs_the_c_fmu_on_the_closed_form_free_vibration() {
     let dir = scratch("simulate");
     let fmu = oscillator_fmu(&dir);
-    let r = simulate::simulate(
+    let (r, ended) = simulate::simulate(
         &fmu,
         &Options {
             stop_time: Some(2.0),
@@ -128,6 +128,7 @@ fn simulate_runs_the_c_fmu_on_the_closed_form_free_vibration() {
         },
     )
     .expect("simulate the C oscillator");
+    assert_eq!(ended, None);
     assert_eq!(r.rows.len(), 201);
     let w = K.sqrt();
     let err = column(&r, "x")

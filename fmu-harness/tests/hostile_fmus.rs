@@ -515,6 +515,7 @@ fn an_absurd_number_of_communication_steps_is_refused_at_once() {
     };
     let kept = fmu_harness::simulate::simulate(&c1, &options)
         .unwrap()
+        .0
         .csv();
     assert!(kept.lines().count() > 2);
     assert!(std::fs::read_to_string(dir.join("out.csv")).unwrap() == kept);

@@ -7,8 +7,17 @@
 //! a panic). A refused call (illegal in this state, a bad argument, an unknown value reference,
 //! a value the scene's rules refuse) returns fmi2Error and leaves a running instance as it was:
 //! the engine guarantees that a refused request changed nothing, so there is nothing to
-//! protect the master from. A step that fails returns fmi2Discard and moves to `StepFailed`,
-//! with the last good state readable.
+//! protect the master from.
+//!
+//! A step that fails returns fmi2Discard with the state put back to the step's start, which
+//! fmi2LastSuccessfulTime reports (FMI 2.0 §4.2.3). Where a smaller step may succeed (Newton,
+//! a singular matrix, a non-finite iterate, the work budget), the instance stays in
+//! `StepComplete`: the master retries fmi2DoStep from that time with a smaller step, or rolls
+//! back with fmi2SetFMUstate. Where no step can (the validity monitor: the model is out of its
+//! range), or where the master repeats the very step that failed (the engine is deterministic,
+//! so it fails the same way: a master such as fmpy's `simulate_fmu` would loop forever), the
+//! instance moves to `StepFailed`, fmi2GetBooleanStatus(fmi2Terminated) answers true and the
+//! log says why; fmi2Terminate, fmi2SetFMUstate and fmi2Reset are what is left.
 
 use super::fmu_state::FmuState;
 use super::guard::Fault;
@@ -26,6 +35,12 @@ pub struct Instance {
     pub(super) logger: Logger,
     pub(super) state: ModelState,
     engine: Engine,
+    /// Why the unit cannot continue (fmi2Terminated = true), set with `StepFailed`.
+    ended: Option<String>,
+    /// The (t, h) of the last step that failed with a Discard a retry may overcome.
+    last_discard: Option<(f64, f64)>,
+    /// The tolerance the master passed to fmi2SetupExperiment (toleranceDefined), if any.
+    master_tolerance: Option<f64>,
 }
 
 impl Instance {
@@ -68,6 +83,9 @@ impl Instance {
             logger,
             state: ModelState::Instantiated,
             engine: Engine::new(scene),
+            ended: None,
+            last_discard: None,
+            master_tolerance: None,
         })
     }
 
@@ -94,6 +112,7 @@ impl Instance {
         }
         if e.is_discard() && self.state == ModelState::StepComplete {
             self.state = ModelState::StepFailed;
+            self.ended = Some(e.to_string());
             return Fault::from(e);
         }
         self.state = ModelState::Error;
@@ -117,27 +136,69 @@ impl Instance {
             .map_err(Fault::refused)
     }
 
-    /// fmi2SetupExperiment: the tolerance goes to `solver.tolerance` when the scene has it.
+    /// The value reference of `solver.tolerance` and the scene's value of it.
+    fn scene_tolerance(&self) -> Option<(u32, f64)> {
+        let v = self.engine.variables().by_name("solver.tolerance")?;
+        Some((v.vr, v.start?))
+    }
+
+    /// fmi2SetupExperiment: a defined tolerance goes to `solver.tolerance`, as the standard asks
+    /// (the master's tolerance is the one to use), with a warning when it is looser than the
+    /// scene's; the log says which tolerance the unit runs at and where it came from.
     pub fn setup_experiment(
         &mut self,
         tolerance: Option<f64>,
         start_time: f64,
     ) -> Result<(), Fault> {
-        if let Some(tolerance) = tolerance {
-            if let Some(vr) = self
-                .engine
-                .variables()
-                .by_name("solver.tolerance")
-                .map(|v| v.vr)
-            {
-                self.engine
-                    .set_real(vr, tolerance)
-                    .map_err(|e| self.fail(e))?;
-            }
+        let scene = self.scene_tolerance();
+        if let (Some(tolerance), Some((vr, _))) = (tolerance, scene) {
+            self.engine
+                .set_real(vr, tolerance)
+                .map_err(|e| self.fail(e))?;
         }
         self.engine
             .set_start_time(start_time)
-            .map_err(|e| self.fail(e))
+            .map_err(|e| self.fail(e))?;
+        self.master_tolerance = tolerance;
+        if let Some((_, scene)) = scene {
+            match tolerance {
+                Some(m) if m > scene => self.logger.status(
+                    fmi2Status::fmi2Warning,
+                    &format!(
+                        "fmi2SetupExperiment: the unit runs at the master's tolerance {m:e} \
+                         (toleranceDefined), looser than the scene's solver.tolerance {scene:e}: \
+                         results may differ from the scene's by more than its tolerance; pass \
+                         the DefaultExperiment's tolerance {scene:e}, or toleranceDefined = \
+                         false, to run at the scene's"
+                    ),
+                ),
+                Some(m) => self.logger.event(&format!(
+                    "tolerance {m:e} from the master (fmi2SetupExperiment, toleranceDefined); \
+                     the scene's solver.tolerance is {scene:e}"
+                )),
+                None => self.logger.event(&format!(
+                    "tolerance {scene:e} from the scene (solver.tolerance): the master \
+                     defined none"
+                )),
+            }
+        }
+        Ok(())
+    }
+
+    /// Where the tolerance the unit runs at came from, for the log at initialization.
+    fn tolerance_report(&mut self) -> Option<String> {
+        let (vr, scene) = self.scene_tolerance()?;
+        let now = self.engine.get_real(vr).ok()?;
+        let source = if self.master_tolerance == Some(now) {
+            "the master's fmi2SetupExperiment (toleranceDefined)"
+        } else if now == scene {
+            "the scene (solver.tolerance)"
+        } else {
+            "the parameter solver.tolerance, set by the master"
+        };
+        Some(format!(
+            "runs at tolerance {now:e}, from {source}; the scene's is {scene:e}"
+        ))
     }
 
     pub fn enter_initialization_mode(&mut self) -> Result<(), Fault> {
@@ -149,6 +210,9 @@ impl Instance {
         self.engine
             .exit_initialization()
             .map_err(|e| self.fail(e))?;
+        if let Some(report) = self.tolerance_report() {
+            self.logger.event(&report);
+        }
         self.transition(ModelState::StepComplete);
         Ok(())
     }
@@ -161,6 +225,9 @@ impl Instance {
     /// fmi2Reset: as right after fmi2Instantiate (the debug-logging settings stay).
     pub fn reset(&mut self) -> Result<(), Fault> {
         self.engine.reset();
+        self.ended = None;
+        self.last_discard = None;
+        self.master_tolerance = None;
         self.transition(ModelState::Instantiated);
         Ok(())
     }
@@ -219,11 +286,66 @@ impl Instance {
     }
 
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), Fault> {
+        if self.state == ModelState::StepFailed {
+            let why = self.ended.as_deref().unwrap_or("a step failed");
+            return Err(Fault::refused(format!(
+                "the unit has ended the simulation at t = {} (fmi2Terminated = true): {why}; \
+                 call fmi2Terminate, or go back with fmi2SetFMUstate or fmi2Reset",
+                self.engine.time()
+            )));
+        }
         let result = self.engine.do_step(t, h);
         for message in self.engine.take_messages() {
             self.logger.status(fmi2Status::fmi2Warning, &message);
         }
-        result.map_err(|e| self.fail(e))
+        match result {
+            Ok(()) => {
+                self.last_discard = None;
+                Ok(())
+            }
+            Err(e) if e.is_discard() && self.state == ModelState::StepComplete => {
+                Err(self.discard(e, t, h))
+            }
+            Err(e) => Err(self.fail(e)),
+        }
+    }
+
+    /// A step that failed with a Discard: the state is back at `t`. A retry from there with a
+    /// smaller step may succeed, unless the model is out of its range or the master repeated
+    /// the step that failed; then the unit ends the simulation (fmi2Terminated = true).
+    fn discard(&mut self, e: EngineError, t: f64, h: f64) -> Fault {
+        let good = self.engine.time();
+        let why = if e.ends_run() {
+            Some("a smaller step cannot get past this")
+        } else if self.last_discard == Some((t, h)) {
+            Some(
+                "the master repeated the step that failed, with the same size; the unit is \
+                 deterministic, so it fails the same way (a retry needs a smaller step)",
+            )
+        } else {
+            None
+        };
+        let message = match why {
+            Some(why) => {
+                self.ended = Some(format!("{e}; {why}"));
+                self.state = ModelState::StepFailed;
+                format!(
+                    "{e}; {why}: the unit ends the simulation at its last good time t = {good} s \
+                     (fmi2LastSuccessfulTime; fmi2Terminated = true)"
+                )
+            }
+            None => {
+                self.last_discard = Some((t, h));
+                format!(
+                    "{e}; the state is back at the last good time t = {good} s \
+                     (fmi2LastSuccessfulTime): retry fmi2DoStep from there with a smaller step"
+                )
+            }
+        };
+        Fault {
+            status: fmi2Status::fmi2Discard,
+            message,
+        }
     }
 
     pub fn cancel_step(&mut self) -> Result<(), Fault> {
@@ -243,6 +365,8 @@ impl Instance {
             )));
         }
         self.transition(s.model_state());
+        self.ended = None;
+        self.last_discard = None;
         self.logger
             .event(&format!("FMU state restored at t = {}", self.engine.time()));
         Ok(())
@@ -283,9 +407,11 @@ impl Instance {
         )))
     }
 
-    /// fmi2Terminated: false, this FMU never asks to end the simulation.
+    /// fmi2Terminated: true once a step has failed in a way no retry overcomes (see the
+    /// module's comment); the log said why.
     pub fn get_boolean_status(&self, kind: fmi2StatusKind) -> Result<fmi2Boolean, Fault> {
         match kind {
+            t::fmi2Terminated if self.ended.is_some() => Ok(fmi2True),
             t::fmi2Terminated => Ok(fmi2False),
             other => Err(Fault::refused(format!(
                 "status kind {other} has no Boolean value"

@@ -141,7 +141,8 @@ impl Call {
             C::GetDirectionalDerivative => INIT | STEPPING | TERMINATED | ERROR,
             C::SetRealInputDerivatives => INSTANTIATED | INIT | S::StepComplete.bit(),
             C::GetRealOutputDerivatives => STEPPING | TERMINATED | ERROR,
-            C::DoStep => S::StepComplete.bit(),
+            // From StepFailed only to be told why the unit ended (`Instance::do_step`).
+            C::DoStep => S::StepComplete.bit() | S::StepFailed.bit(),
             C::CancelStep => STEPPING,
             C::GetStatus
             | C::GetRealStatus
@@ -173,7 +174,6 @@ mod tests {
         for s in [
             S::Instantiated,
             S::InitializationMode,
-            S::StepFailed,
             S::Terminated,
             S::Error,
         ] {

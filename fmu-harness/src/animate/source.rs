@@ -100,7 +100,12 @@ pub fn run_fmu(
         step,
         outputs: Vec::new(),
     };
-    let r = crate::simulate::simulate(path, &options)?;
+    // A run the FMU ended early is drawn up to its last good time; the CSV and the page
+    // show where it stops.
+    let (r, ended) = crate::simulate::simulate(path, &options)?;
+    if let Some(ended) = ended {
+        eprintln!("warning: {ended}");
+    }
     let mut columns = vec!["time".to_string()];
     columns.extend(r.columns);
     let values = (0..columns.len())

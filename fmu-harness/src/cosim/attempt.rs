@@ -14,6 +14,11 @@ pub(super) enum Refused {
         unit: String,
         messages: Vec<LogMessage>,
     },
+    /// fmi2Discard with fmi2Terminated: the unit cannot go on; the run ends at t.
+    Ended {
+        unit: String,
+        messages: Vec<LogMessage>,
+    },
     Check {
         variable: String,
         value: f64,
@@ -32,7 +37,7 @@ pub(super) enum Refused {
 impl Refused {
     pub(super) fn text(&self) -> String {
         match self {
-            Refused::Discard { unit, messages } => {
+            Refused::Discard { unit, messages } | Refused::Ended { unit, messages } => {
                 let m: Vec<_> = messages.iter().map(|m| m.message.as_str()).collect();
                 if m.is_empty() {
                     format!("unit `{unit}`: fmi2DoStep returned fmi2Discard")
@@ -119,10 +124,13 @@ pub(super) fn attempt(
                 messages,
                 ..
             }) => {
-                return Ok(Some(Refused::Discard {
-                    unit: u.name.clone(),
-                    messages,
-                }))
+                let unit = u.name.clone();
+                let ended = u.slave.terminated().map_err(|e| u.fail(e))?;
+                return Ok(Some(if ended {
+                    Refused::Ended { unit, messages }
+                } else {
+                    Refused::Discard { unit, messages }
+                }));
             }
             Err(e) => return Err(u.fail(e)),
         }

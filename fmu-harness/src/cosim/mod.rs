@@ -105,6 +105,14 @@ pub enum CosimError {
     TooManySteps { t: f64, steps: u64, limit: f64 },
     #[error("writing the results: {0}")]
     Output(#[source] std::io::Error),
+    /// A unit returned fmi2Discard and fmi2Terminated: the run ends at t (not an error of the
+    /// run: [`run_into`] ends cleanly, with [`Summary::ended`]).
+    #[error("unit `{unit}` ended the simulation at t = {t}: {reason}")]
+    UnitEnded {
+        unit: String,
+        t: f64,
+        reason: String,
+    },
 }
 
 /// One unit: its slave and what the master knows of it.
@@ -258,7 +266,16 @@ pub fn run_into(
         if !variable_step {
             h_try = h_try.min(h);
         }
-        let step = master.step(t, h_try, h)?;
+        let step = match master.step(t, h_try, h) {
+            Err(CosimError::UnitEnded { unit, t, reason }) => {
+                master.summary.ended = Some(format!(
+                    "unit `{unit}` ended the simulation at t = {t} s (fmi2Discard, \
+                     fmi2Terminated); every row up to that time is recorded: {reason}"
+                ));
+                break;
+            }
+            other => other?,
+        };
         t += step.h;
         if !variable_step && is_close(t, target) {
             t = target;

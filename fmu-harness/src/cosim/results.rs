@@ -24,6 +24,8 @@ pub struct Summary {
     pub unit_steps: u64,
     /// The joint coupling's counters, when the system has joints.
     pub joints: Option<JointStats>,
+    /// Why the run ended before the stop time: a unit returned fmi2Discard with fmi2Terminated.
+    pub ended: Option<String>,
 }
 
 impl Summary {
@@ -58,6 +60,9 @@ impl Summary {
         }
         for r in &self.retry_reasons {
             s.push_str(&format!("  retried: {r}\n"));
+        }
+        if let Some(e) = &self.ended {
+            s.push_str(&format!("ended early: {e}\n"));
         }
         s
     }

@@ -96,6 +96,10 @@ impl Master<'_> {
     /// the run ends with the error saying why.
     fn roll_back(&mut self, why: Refused, t: f64, h: f64, halvings: u32) -> Result<(), CosimError> {
         let reason = why.text();
+        if let Refused::Ended { unit, .. } = why {
+            // no retry: the unit said it cannot go on; the run ends at t, its rows kept
+            return Err(CosimError::UnitEnded { unit, t, reason });
+        }
         let r = match self.rollback {
             Some(r) if r.on_discard || matches!(why, Refused::Check { .. }) => r,
             _ => {

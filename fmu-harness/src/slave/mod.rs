@@ -338,6 +338,36 @@ impl Slave {
         self.check(F, s)
     }
 
+    /// fmi2GetBooleanStatus(fmi2Terminated): whether the FMU asks to end the simulation (after
+    /// a Discard). False when the FMU does not export the function or does not answer it
+    /// (fmi2Error, as an FMU that never ends a simulation may); what it logged then is dropped.
+    pub fn terminated(&mut self) -> Result<bool, SlaveError> {
+        const F: &str = "fmi2GetBooleanStatus";
+        match self
+            .live(F)?
+            .get_boolean_status(fmi2_binding::fmi2Terminated)
+        {
+            Ok((s, value)) if s.is_success() => Ok(value),
+            Ok(_) | Err(Refusal::NotExported(_)) => {
+                let _ = self.take_messages();
+                Ok(false)
+            }
+            Err(r) => Err(Self::refused(F, r)),
+        }
+    }
+
+    /// fmi2GetRealStatus(fmi2LastSuccessfulTime): the time of the FMU's last good state.
+    pub fn last_successful_time(&mut self) -> Result<f64, SlaveError> {
+        const F: &str = "fmi2GetRealStatus";
+        match self
+            .live(F)?
+            .get_real_status(fmi2_binding::fmi2LastSuccessfulTime)
+        {
+            Ok((s, value)) => self.check(F, s).map(|_| value),
+            Err(r) => Err(Self::refused(F, r)),
+        }
+    }
+
     pub fn terminate(&mut self) -> Result<Status, SlaveError> {
         const F: &str = "fmi2Terminate";
         let s = self.live(F)?.terminate();
