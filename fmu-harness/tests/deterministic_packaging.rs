@@ -61,7 +61,7 @@ fn archive_holds_the_fmi_layout_with_fixed_metadata() {
     // the documentation is the explanation of the resolved effects
     let doc = read_entry(&out, "documentation/index.html");
     assert!(
-        doc.contains("quadratic_velocity (beam)") && doc.contains("effects = all"),
+        doc.contains("quadratic_velocity (beam)") && doc.contains("effects = scene"),
         "{doc}"
     );
     for i in 0..z.len() {

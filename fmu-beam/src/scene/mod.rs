@@ -70,19 +70,23 @@ pub struct Scene {
     /// Point forces and torques on frames.
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadSpec>,
-    /// What to simulate: `"all"` (default: the full model), `"auto"` (the generator decides
-    /// from the scene, `fmu-harness explain` says why), or a list of effect names: gravity,
-    /// flexibility, axial, quadratic_velocity, geometric_stiffening, rayleigh_damping.
+    /// What to simulate: `"scene"` (default: every term, geometric stiffening where a beam
+    /// asks for it), `"all"` (every effect, geometric stiffening on every flexible beam),
+    /// `"auto"` (the generator decides from the scene, `fmu-harness explain` says why), or a
+    /// list of effect names: gravity, flexibility, axial, quadratic_velocity,
+    /// geometric_stiffening, rayleigh_damping.
     #[serde(default)]
     pub effects: EffectsSpec,
 }
 
-/// The scene's `effects`: a mode (`"all"`, `"auto"`) or the list of effects to simulate.
+/// The scene's `effects`: a mode (`"scene"`, `"all"`, `"auto"`) or the list of effects to
+/// simulate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(untagged)]
 pub enum EffectsSpec {
-    /// `"all"` (the full model) or `"auto"` (the generator decides from the scene).
+    /// `"scene"` (every term, geometric stiffening where a beam asks for it), `"all"` (every
+    /// effect, geometric stiffening included) or `"auto"` (the generator decides).
     Mode(String),
     /// The effects to simulate, by name; those not listed are off.
     List(Vec<String>),
@@ -90,7 +94,7 @@ pub enum EffectsSpec {
 
 impl Default for EffectsSpec {
     fn default() -> Self {
-        EffectsSpec::Mode("all".into())
+        EffectsSpec::Mode("scene".into())
     }
 }
 

@@ -546,9 +546,9 @@ pub(crate) const SCALE_NOT_INPUT: Rule = rule(
 pub(crate) const EFFECTS_MODE: Rule = rule(
     "effects_mode",
     &["effects"],
-    "must be \"all\", \"auto\" or a list of effects",
+    "must be \"scene\", \"all\", \"auto\" or a list of effects",
     Any,
-    Schema::OneOf(&["all", "auto"]),
+    Schema::OneOf(&["scene", "all", "auto"]),
 );
 pub(crate) const EFFECT_KNOWN: Rule = rule(
     "effect_known",

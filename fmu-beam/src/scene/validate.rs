@@ -316,7 +316,7 @@ impl Scene {
 /// `effects`: a known mode or a list of known, distinct effects that fit the beams.
 fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
     let names = match &scene.effects {
-        EffectsSpec::Mode(m) if m == "all" || m == "auto" => return Ok(()),
+        EffectsSpec::Mode(m) if ["scene", "all", "auto"].contains(&m.as_str()) => return Ok(()),
         EffectsSpec::Mode(m) => return Err(ck.fail(&r::EFFECTS_MODE, "effects", format!("{m:?}"))),
         EffectsSpec::List(names) => names,
     };

@@ -6,6 +6,7 @@
 #[path = "../../tests/common/mod.rs"]
 mod common;
 
+mod beam_damping;
 mod planar_beam_element;
 mod planar_spatial_agreement;
 mod sparse_iteration_matrix;

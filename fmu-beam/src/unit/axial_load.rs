@@ -35,7 +35,7 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
         b.geometric_stiffening = false;
         b.modes = None;
     }
-    rigid.effects = EffectsSpec::Mode("all".into());
+    rigid.effects = EffectsSpec::Mode("scene".into());
     let effects: Effects = crate::unit::effects::resolve(&rigid).effects;
     let sys = System::build(&rigid, &effects);
     let (t0, stop) = (scene.experiment.start_time, scene.experiment.stop_time);

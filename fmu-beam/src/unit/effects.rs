@@ -1,8 +1,9 @@
 //! Effects: which physical terms a scene's unit computes, and why.
 //!
-//! A scene's `effects` is `"all"` (the default: every term of the model as the scene's entries
-//! describe it), a list of effect names (exactly those are on), or `"auto"` (decided here from
-//! the scene: its gravity field, what its drives and loads excite, how fast its beams spin).
+//! A scene's `effects` is `"scene"` (the default: every term of the model, geometric stiffening
+//! for the beams that ask for it), `"all"` (every effect, geometric stiffening on every flexible
+//! beam), a list of effect names (exactly those are on), or `"auto"` (decided here from the
+//! scene: its gravity field, what its drives and loads excite, how fast its beams spin).
 //! [`resolve`] turns that into [`Effects`] (what [`crate::mechanics::multibody::System`] builds) and a list
 //! of [`Decision`]s with the reason for each and its estimated share of the cost of a step
 //! (what `fmu-harness explain` prints and the FMU carries in `documentation/`). A term that is
@@ -243,7 +244,9 @@ pub fn resolve(scene: &Scene) -> Resolution {
             finish(scene, "list", effects, |_, _| "listed in `effects`".into())
         }
         crate::scene::EffectsSpec::Mode(m) if m == "auto" => auto(scene),
-        crate::scene::EffectsSpec::Mode(_) => {
+        crate::scene::EffectsSpec::Mode(m) => {
+            // "all": every effect, stiffening on every flexible beam; "scene": where asked
+            let every = m == "all";
             let effects = Effects {
                 gravity: true,
                 beams: scene
@@ -252,17 +255,48 @@ pub fn resolve(scene: &Scene) -> Resolution {
                     .map(|b| BeamEffects {
                         rigid: b.rigid,
                         options: BeamOptions {
-                            geometric_stiffening: b.geometric_stiffening,
+                            geometric_stiffening: b.geometric_stiffening || (every && !b.rigid),
                             modes: b.modes,
                             ..all()
                         },
                     })
                     .collect(),
             };
-            finish(scene, "all", effects, |_, _| {
-                "effects = \"all\" (the default): the full model".into()
+            let mode = if every { "all" } else { "scene" };
+            finish(scene, mode, effects, |effect, subject| {
+                mode_reason(scene, every, effect, subject)
             })
         }
+    }
+}
+
+/// Why `effects = "scene"` (`every` false) or `"all"` resolves `effect` of `subject` as it does.
+fn mode_reason(scene: &Scene, every: bool, effect: &str, subject: &str) -> String {
+    let mode = if every {
+        "effects = \"all\": every effect"
+    } else {
+        "effects = \"scene\" (the default): every term of the element"
+    };
+    let beam = scene.beams.iter().find(|b| b.name == subject);
+    match (effect, beam) {
+        ("flexibility", Some(b)) if b.rigid => {
+            "the scene makes the beam rigid (rigid = true)".into()
+        }
+        ("geometric_stiffening", Some(_)) if every => {
+            format!("{mode}, geometric stiffening included")
+        }
+        ("geometric_stiffening", Some(b)) if b.geometric_stiffening => {
+            "asked for by the beam (geometric_stiffening = true)".into()
+        }
+        ("geometric_stiffening", Some(_)) => "the beam does not ask for it (geometric_stiffening \
+             = false); effects = \"all\" turns it on for every beam, \"auto\" where spin or \
+             axial force needs it"
+            .into(),
+        ("rayleigh_damping", Some(b)) => format!(
+            "{mode}: alpha = {}, beta = {}",
+            b.rayleigh.alpha, b.rayleigh.beta
+        ),
+        _ => mode.into(),
     }
 }
 
@@ -275,16 +309,18 @@ fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
     let (mode, listed): (&'static str, &[String]) = match &scene.effects {
         EffectsSpec::List(names) => ("list", names),
         EffectsSpec::Mode(m) if m == "auto" => ("auto", &[]),
-        EffectsSpec::Mode(_) => ("all", &[]),
+        EffectsSpec::Mode(m) if m == "all" => ("all", &[]),
+        EffectsSpec::Mode(_) => ("scene", &[]),
     };
     let on = |e: &str| match mode {
         "list" => Some(listed.iter().any(|n| n == e)),
-        "all" => Some(true),
+        "all" | "scene" => Some(true),
         _ => None,
     };
     let reason = |auto: &str| match mode {
         "list" => "listed in `effects`".to_string(),
-        "all" => "effects = \"all\" (the default): the full model".to_string(),
+        "all" => "effects = \"all\": every effect".to_string(),
+        "scene" => "effects = \"scene\" (the default): every term of the element".to_string(),
         _ => auto.to_string(),
     };
     let field = scene.world.gravity != [0.0; 3];
@@ -326,15 +362,49 @@ fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
             cost_share: 0.0,
         });
         if !rigid {
+            // the 3D element's terms that cannot be switched, listed so that `explain` shows
+            // exactly what is on
+            let always = |effect: &'static str, why: &str| Decision {
+                effect,
+                subject: b.name.clone(),
+                setting: "on".into(),
+                why: format!("the 3D element always computes {why}"),
+                cost_share: 0.0,
+            };
+            decisions.push(always("axial", "axial deformation"));
+            decisions.push(always(
+                "quadratic_velocity",
+                "the centrifugal and Coriolis terms",
+            ));
+            decisions.push(Decision {
+                effect: "geometric_stiffening",
+                subject: b.name.clone(),
+                setting: "off".into(),
+                why: format!(
+                    "{}the 3D element has no geometric stiffening: substructures carry the \
+                     stiffening of large deflection (docs/3d.md)",
+                    if mode == "all" {
+                        "effects = \"all\" cannot turn it on: "
+                    } else {
+                        ""
+                    }
+                ),
+                cost_share: 0.0,
+            });
             decisions.push(Decision {
                 effect: "rayleigh_damping",
                 subject: b.name.clone(),
                 setting: on_off(damping),
-                why: reason(if damped {
-                    "damping coefficients given"
-                } else {
-                    "both damping coefficients are zero"
-                }),
+                why: format!(
+                    "{}: alpha = {}, beta = {}",
+                    reason(if damped {
+                        "damping coefficients given"
+                    } else {
+                        "both damping coefficients are zero"
+                    }),
+                    b.rayleigh.alpha,
+                    b.rayleigh.beta
+                ),
                 cost_share: 0.0,
             });
         }

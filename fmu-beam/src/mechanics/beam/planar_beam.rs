@@ -144,7 +144,8 @@ pub struct PlanarBeam {
     pub ea: f64,
     /// Bending stiffness E·J (N m^2).
     pub ej: f64,
-    /// Mass-proportional Rayleigh coefficient α (1/s) of D_ff.
+    /// Mass-proportional Rayleigh coefficient α (1/s): the system applies it to the whole beam,
+    /// relative to the beam's reference frame (`multibody/beam_damping.rs`), not in D_ff.
     pub rayleigh_alpha: f64,
     /// Stiffness-proportional Rayleigh coefficient β (s) of D_ff.
     pub rayleigh_beta: f64,
@@ -168,7 +169,7 @@ pub struct PlanarBeam {
     pub w: DMatrix<f64>,
     /// K_ff, the linear stiffness matrix over the kept coordinates.
     pub kff: DMatrix<f64>,
-    /// D_ff = alpha m_ff + beta K_ff.
+    /// D_ff = β K_ff, the stiffness-proportional Rayleigh damping on the strain rates.
     pub dff: DMatrix<f64>,
     /// Flange a: the material point at the root (x = 0).
     pub flange_a: PointMap,

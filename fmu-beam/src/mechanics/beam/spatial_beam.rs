@@ -87,7 +87,8 @@ pub struct SpatialBeamProps {
     pub g: f64,
     /// Section constants: area, second moments, torsion constant, polar moment.
     pub section: SpatialSection,
-    /// D_ff = alpha m_ff + beta K_ff.
+    /// Mass-proportional Rayleigh coefficient α (1/s), applied by the system to the whole beam
+    /// (`multibody/beam_damping.rs`).
     pub rayleigh_alpha: f64,
     /// Stiffness-proportional Rayleigh coefficient β (s) of D_ff.
     pub rayleigh_beta: f64,
@@ -293,7 +294,8 @@ pub struct SpatialBeam {
     /// How the inertia terms are evaluated; always [`InertiaModel::Frozen`] without shape
     /// integrals ([`SpatialBeam::set_inertia`]).
     pub inertia: InertiaModel,
-    /// Mass-proportional Rayleigh coefficient α (1/s): D_ff = α m_ff + β K_ff.
+    /// Mass-proportional Rayleigh coefficient α (1/s): the system applies it to the whole beam,
+    /// relative to the beam's reference frame (`multibody/beam_damping.rs`), not in D_ff.
     pub rayleigh_alpha: f64,
     /// Stiffness-proportional Rayleigh coefficient β (s).
     pub rayleigh_beta: f64,
@@ -309,7 +311,8 @@ pub struct SpatialBeam {
     pub mff: DMatrix<f64>,
     /// K_ff, the stiffness matrix over the kept coordinates.
     pub kff: DMatrix<f64>,
-    /// D_ff = α m_ff + β K_ff, the Rayleigh damping matrix.
+    /// D_ff = β K_ff, the stiffness-proportional Rayleigh damping on the strain rates (the α
+    /// part acts on the whole beam, `multibody/beam_damping.rs`).
     pub dff: DMatrix<f64>,
     /// Flange a: the material point at the root (x = 0).
     pub flange_a: SpatialPointMap,

@@ -1,5 +1,6 @@
 //! Bodies, frames and joints, assembled into M(q) q'' + G(q)ᵀλ = Q(q, q', t); g(q, t) = 0.
 
+pub(crate) mod beam_damping;
 pub(crate) mod body;
 pub(crate) mod equations;
 pub(crate) mod frame;

@@ -17,6 +17,7 @@ use crate::mechanics::Effects;
 use nalgebra::{DVector, DVectorView, Vector2};
 use std::ops::Range;
 
+mod damping;
 mod readouts;
 
 /// Energies of the system (J).
@@ -434,6 +435,11 @@ impl super::equations::Equations for System {
                 &mut r.as_mut_slice()[o..o + n],
             );
         }
+        for g in 0..self.beams.len() {
+            if let Some(d) = self.beam_damping(g, q) {
+                d.add_force(v, r);
+            }
+        }
         for l in &self.loads {
             let fs = self.frame_state(l.frame, q, None);
             let (force, torque) = self.load_value(l, t);
@@ -466,6 +472,11 @@ impl super::equations::Equations for System {
                 kt.blocks[i].view_mut((0, 0), (n, n)),
                 ct.blocks[i].view_mut((0, 0), (n, n)),
             );
+        }
+        for g in 0..self.beams.len() {
+            if let Some(d) = self.beam_damping(g, q) {
+                d.add_tangent(ct);
+            }
         }
         for j in &self.joints {
             let (_, _, rows) = self.joint_rows(j, q, None, t);

@@ -30,6 +30,7 @@
 //! second derivative. The norm rows are exact.
 
 pub(crate) mod body;
+pub(crate) mod damping;
 pub(crate) mod frame;
 pub(crate) mod joint;
 pub(crate) mod quaternion;

@@ -650,6 +650,11 @@ impl Equations for System3 {
             );
             r.rows_mut(o, n).copy_from(&ri);
         }
+        for g in 0..self.beams.len() {
+            if let Some(d) = self.beam_damping(g, q) {
+                d.add_force(v, r);
+            }
+        }
         for (k, f) in self.applied(q, t) {
             r[k] -= f;
         }
@@ -679,6 +684,11 @@ impl Equations for System3 {
             );
             for k in 0..4 {
                 kb[(3 + k, 3 + k)] += 2.0 * lambda[i];
+            }
+        }
+        for g in 0..self.beams.len() {
+            if let Some(d) = self.beam_damping(g, q) {
+                d.add_tangent(ct);
             }
         }
     }

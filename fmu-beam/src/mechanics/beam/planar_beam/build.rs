@@ -64,7 +64,7 @@ impl PlanarBeam {
         let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
         let mff = pick(&full.mff);
         let kff = pick(&full.kff);
-        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
+        let dff = &kff * rayleigh_beta;
         let mass = mu * length;
         let node_map = |node: usize, x: f64| {
             let mut sp_full = DMatrix::zeros(2, n_full);
@@ -150,7 +150,7 @@ impl PlanarBeam {
         self.w = &pt * &self.w * &phi;
         self.mff = &pt * &self.mff * &phi;
         self.kff = &pt * &self.kff * &phi;
-        self.dff = &self.mff * self.rayleigh_alpha + &self.kff * self.rayleigh_beta;
+        self.dff = &self.kff * self.rayleigh_beta;
         for map in [&mut self.flange_a, &mut self.flange_b] {
             reduce_map(map, &phi);
         }

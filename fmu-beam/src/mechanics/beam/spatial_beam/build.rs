@@ -68,7 +68,7 @@ impl SpatialBeam {
         let undeformed = UndeformedInertia::from_nodal_mass(mass, &x, &kept);
         let mff = pick(mass);
         let kff = pick(stiffness);
-        let dff = &mff * rayleigh_alpha + &kff * rayleigh_beta;
+        let dff = &kff * rayleigh_beta;
         let mut beam = SpatialBeam {
             name: name.to_string(),
             length,
