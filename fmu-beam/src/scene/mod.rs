@@ -13,6 +13,7 @@ pub mod matrix_file;
 mod planar;
 pub mod rules;
 mod size;
+pub use size::TABLE_PARAMETER_ROWS;
 mod space;
 mod validate;
 pub mod xyz;
