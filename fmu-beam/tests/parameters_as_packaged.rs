@@ -284,3 +284,120 @@ fn table_rows_are_parameters_up_to_a_bound_and_the_size_bound_holds() {
         assert!(count <= s.size().variables, "{count} > {:?}", s.size());
     }
 }
+
+/// PLANAR with its hinge started at 0.4 rad and 2 rad/s, and a second link on an elbow at the
+/// arm's tip whose start is not given.
+fn planar_started() -> String {
+    PLANAR.replace(
+        r#"drive = { kind = "effort""#,
+        r#"initial = { position = 0.4, speed = 2.0 }
+drive = { kind = "effort""#,
+    ) + r#"
+[[body]]
+name = "link"
+mass = 0.5
+inertia = 0.01
+com = [0.2, 0.0]
+position = [0.6, 0.0]
+[[joint]]
+name = "elbow"
+type = "revolute"
+frames = ["arm.tip", "link.origin"]
+"#
+}
+
+/// SPATIAL with its ball on a revolute joint about world y, started at 0.3 rad and -1.5 rad/s.
+fn spatial_started() -> String {
+    SPATIAL.replace(
+        r#"type = "spherical""#,
+        "type = \"revolute\"\naxis = [0.0, 1.0, 0.0]\ninitial = { position = 0.3, speed = -1.5 }",
+    )
+}
+
+fn started(text: &str, set: &[(&str, f64)]) -> Engine {
+    let mut e = Engine::new(scene(text));
+    for (name, v) in set {
+        let vr = e.variables().by_name(name).unwrap().vr;
+        e.set_real(vr, *v).unwrap();
+    }
+    e.exit_initialization().unwrap();
+    e
+}
+
+fn get(e: &mut Engine, name: &str) -> f64 {
+    let vr = e.variables().by_name(name).unwrap().vr;
+    e.get_real(vr).unwrap()
+}
+
+/// A joint given a start coordinate and rate starts there, the bodies placed and moving to meet
+/// it; a joint without one keeps its placed coordinate and turns with its neighbours (the elbow
+/// stays straight, at rest relative to the arm).
+#[test]
+fn a_joint_starts_at_the_coordinate_and_rate_given() {
+    let mut e = started(&planar_started(), &[]);
+    assert!((get(&mut e, "hinge.angle") - 0.4).abs() < 1e-12);
+    assert!((get(&mut e, "hinge.speed") - 2.0).abs() < 1e-9);
+    assert!(get(&mut e, "elbow.angle").abs() < 1e-12);
+    assert!(get(&mut e, "elbow.speed").abs() < 1e-9);
+    // the link moved with the arm: its origin at the arm's tip, 0.6 m from the hinge at 0.4 rad
+    let (x, y) = (get(&mut e, "link.x"), get(&mut e, "link.y"));
+    assert!((x - 0.6 * 0.4f64.cos()).abs() < 1e-12 && (y - 0.6 * 0.4f64.sin()).abs() < 1e-12);
+    let mut e = started(&planar_started(), &[("hinge.initial.speed", -1.0)]);
+    assert!((get(&mut e, "hinge.speed") + 1.0).abs() < 1e-9);
+    let mut e = started(&spatial_started(), &[]);
+    assert!((get(&mut e, "pivot.angle") - 0.3).abs() < 1e-12);
+    assert!((get(&mut e, "pivot.speed") + 1.5).abs() < 1e-9);
+    // a rigid turn about world y through the pivot: ½ ω² (Iyy + m d²), d the centre of mass's
+    // distance from the axis (com − pivot = [0.55, 0.01, -0.02] in body axes, turned about y)
+    let expected = 0.5 * 1.5f64.powi(2) * (0.02 + 1.0 * (0.55f64.powi(2) + 0.02f64.powi(2)));
+    let kinetic = get(&mut e, "energy.kinetic");
+    assert!(
+        (kinetic - expected).abs() < 1e-9 * expected,
+        "{kinetic} {expected}"
+    );
+}
+
+#[test]
+fn a_joint_s_start_runs_as_packaged() {
+    fn start(s: &mut Scene, j: usize) -> &mut fmu_beam::scene::JointInitialSpec {
+        s.joints[j].initial.as_mut().unwrap()
+    }
+    let planar = planar_started();
+    same_as_packaged(&planar, "hinge.initial.position", -0.2, |s| {
+        start(s, 1).position = Some(-0.2)
+    });
+    same_as_packaged(&planar, "hinge.initial.speed", 5.0, |s| {
+        start(s, 1).speed = Some(5.0)
+    });
+    let spatial = spatial_started();
+    same_as_packaged(&spatial, "pivot.initial.position", 1.0, |s| {
+        start(s, 1).position = Some(1.0)
+    });
+    same_as_packaged(&spatial, "pivot.initial.speed", 0.5, |s| {
+        start(s, 1).speed = Some(0.5)
+    });
+}
+
+/// Speeds the joints cannot all take (a crank and its slider at the dead point) are refused,
+/// naming the joints; a crank's speed alone sets the whole slider-crank moving.
+#[test]
+fn speeds_the_joints_do_not_allow_are_refused() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/slider_crank.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let crank = text.replace(
+        "frames = [\"world\", \"crank.a\"]",
+        "frames = [\"world\", \"crank.a\"]\ninitial = { speed = 3.0 }",
+    );
+    let mut e = started(&crank, &[]);
+    assert!((get(&mut e, "crank_pivot.speed") - 3.0).abs() < 1e-9);
+    let both = crank.replace(
+        "frames = [\"world\", \"block.origin\"]",
+        "frames = [\"world\", \"block.origin\"]\ninitial = { speed = 1.0 }",
+    );
+    let mut e = Engine::new(scene(&both));
+    let err = e.exit_initialization().unwrap_err().to_string();
+    assert!(
+        err.contains("initial speeds") && err.contains("slider"),
+        "{err}"
+    );
+}

@@ -32,6 +32,10 @@ pub(super) fn apply(s: &mut Scene, t: ParamTarget, v: f64) {
         T::LoadForce(l, k) => s.loads[l].force[k] = v,
         T::LoadTorque(l, k) => s.loads[l].torque[k] = v,
         T::Law(of, p) => set_law(law_mut(s, of), p, v),
+        T::JointInitialPosition(j) => {
+            s.joints[j].initial.get_or_insert_default().position = Some(v)
+        }
+        T::JointInitialSpeed(j) => s.joints[j].initial.get_or_insert_default().speed = Some(v),
     }
 }
 

@@ -1,5 +1,5 @@
 //! The variables of a scene, in value-reference order: parameters (world, solver, beams,
-//! drives, rigid bodies, loads), inputs, then outputs (beams, shapes, joints, bodies, energy, solver, input loads'
+//! joints' starts, drives, rigid bodies, loads), inputs, then outputs (beams, shapes, joints, bodies, energy, solver, input loads'
 //! frames), each kind by its own function; only the variables of effects that are on.
 //!
 //! Over 600 lines on purpose: every variable a unit can offer, one function per kind in value-
@@ -18,6 +18,7 @@ pub(super) fn variables(scene: &Scene, effects: &Effects) -> Vec<Variable> {
     world_parameters(&mut t, scene, effects);
     solver_parameters(&mut t, scene);
     beam_parameters(&mut t, scene, effects);
+    joint_parameters(&mut t, scene);
     drive_parameters(&mut t, scene);
     body_parameters(&mut t, scene);
     load_parameters(&mut t, scene);
@@ -440,6 +441,39 @@ fn beam_parameters(t: &mut Builder, scene: &Scene, effects: &Effects) {
             V::Fixed,
             "Initial static transverse tip displacement",
         );
+    }
+}
+
+/// Each joint's start, where the scene gives it: `<joint>.initial.position`, `.speed`.
+fn joint_parameters(t: &mut Builder, scene: &Scene) {
+    use ParamTarget as T;
+    for (i, j) in scene.joints.iter().enumerate() {
+        let Some(start) = &j.initial else { continue };
+        let (what, units) = if j.kind == crate::scene::JointKind::Prismatic {
+            ("position along the axis", ["m", "m/s"])
+        } else {
+            ("angle", ["rad", "rad/s"])
+        };
+        if let Some(v) = start.position {
+            t.real_param(
+                format!("{}.initial.position", j.name),
+                T::JointInitialPosition(i),
+                units[0],
+                v,
+                Variability::Fixed,
+                &format!("Joint {what} at the start (the bodies are placed to meet it)"),
+            );
+        }
+        if let Some(v) = start.speed {
+            t.real_param(
+                format!("{}.initial.speed", j.name),
+                T::JointInitialSpeed(i),
+                units[1],
+                v,
+                Variability::Fixed,
+                &format!("Rate of the joint {what} at the start"),
+            );
+        }
     }
 }
 

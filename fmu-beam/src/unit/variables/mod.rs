@@ -129,6 +129,10 @@ pub enum ParamTarget {
     LoadTorque(usize, usize),
     /// A parameter of a time law: a joint's drive law or a load's scale.
     Law(LawOf, LawParam),
+    /// The coordinate of scene joint `usize` at the start (`joint.initial.position`).
+    JointInitialPosition(usize),
+    /// The rate of scene joint `usize` at the start (`joint.initial.speed`).
+    JointInitialSpeed(usize),
 }
 
 /// Whose time law a [`ParamTarget::Law`] parameter sets.
