@@ -10,6 +10,9 @@ use crate::scene::{DriveKind, DriveSpec, JointKind, LawSpec, Scene};
 use crate::unit::effects::Effects;
 use nalgebra::DVector;
 
+/// Coordinates q and velocities q' at the start.
+type Start = (DVector<f64>, DVector<f64>);
+
 /// The coordinates and velocities at `t0` of `system` (built from `scene`, its inputs set) that
 /// meet the joints' initial coordinates and rates, or `None` if the scene gives none.
 pub(super) fn given(
@@ -17,7 +20,7 @@ pub(super) fn given(
     effects: &Effects,
     system: &Mechanics,
     t0: f64,
-) -> Result<Option<(DVector<f64>, DVector<f64>)>, EngineError> {
+) -> Result<Option<Start>, EngineError> {
     let gives = |j: &crate::scene::JointSpec| {
         j.initial
             .as_ref()
