@@ -8,6 +8,7 @@
 //! reference, read in one place.
 
 pub mod files;
+mod joint_start;
 mod limits;
 pub mod matrix_file;
 mod planar;

@@ -248,23 +248,7 @@ impl Scene {
                 ));
             }
             ck.finite(&format!("{field}.axis_angle"), j.axis_angle)?;
-            if let Some(start) = &j.initial {
-                let at = format!("{field}.initial");
-                if !matches!(j.kind, JointKind::Revolute | JointKind::Prismatic) {
-                    return Err(ck.fail(&r::JOINT_INITIAL_KIND, &at, format!("{:?}", j.kind)));
-                }
-                if j.drive
-                    .as_ref()
-                    .is_some_and(|d| d.kind == DriveKind::Motion)
-                {
-                    return Err(ck.fail(&r::JOINT_INITIAL_MOTION, &at, "a motion drive"));
-                }
-                for (name, v) in [("position", start.position), ("speed", start.speed)] {
-                    if let Some(v) = v {
-                        ck.finite(&format!("{at}.{name}"), v)?;
-                    }
-                }
-            }
+            super::joint_start::validate_start(&ck, j, &field)?;
             if let Some(d) = &j.drive {
                 if j.kind == JointKind::Weld {
                     return Err(ck.fail(
