@@ -384,3 +384,23 @@ fn auto_warns_when_parameters_would_change_its_choice() {
     e.exit_initialization().unwrap();
     assert!(e.take_messages().is_empty());
 }
+
+/// Issue 31: a revolute joint started at speed counts as spin. C4's single-frame beam without
+/// its drive, started at 10 rad/s (3.4 x its first bending frequency), needs geometric
+/// stiffening as the spin-up to 10 rad/s does; at rest it does not.
+#[test]
+fn auto_counts_a_joint_s_start_speed_as_spin() {
+    let mut s = auto("spin_up_omega10_single_frame.toml");
+    s.joints[0].drive = None;
+    let stiffening = |s: &Scene| {
+        summary(s)
+            .iter()
+            .any(|d| d == "geometric_stiffening(beam)=on")
+    };
+    assert!(!stiffening(&s));
+    s.joints[0].initial = Some(fmu_beam::scene::JointInitialSpec {
+        position: None,
+        speed: Some(10.0),
+    });
+    assert!(stiffening(&s), "{:?}", summary(&s));
+}

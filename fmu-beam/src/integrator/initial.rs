@@ -9,15 +9,26 @@ use nalgebra::{DMatrix, DVector};
 
 const ASSEMBLY_ITERATIONS: usize = 50;
 
-/// Builds the state at `t0` from the system's initial configuration.
+/// Builds the state at `t0` from the system's initial configuration, at rest.
 pub fn initial_state<S: Equations + ?Sized>(
     sys: &S,
     t0: f64,
     settings: &Settings,
 ) -> Result<GaState, EngineError> {
+    let q = sys.initial_coordinates()?;
+    initial_state_from(sys, t0, settings, q, DVector::zeros(sys.n()))
+}
+
+/// Builds the state at `t0` from coordinates `q` (assembled here if they do not meet the joints
+/// yet) and velocities `v` (which must meet them: [`super::given_start`]).
+pub fn initial_state_from<S: Equations + ?Sized>(
+    sys: &S,
+    t0: f64,
+    settings: &Settings,
+    mut q: DVector<f64>,
+    v: DVector<f64>,
+) -> Result<GaState, EngineError> {
     let (n, m) = (sys.n(), sys.m());
-    let mut q = sys.initial_coordinates()?;
-    let v = DVector::zeros(n);
     let tol = 1e-12 * sys.length_scale().max(1.0);
     let mut g = DVector::zeros(m);
     let mut gm = DMatrix::zeros(m, n);
@@ -98,6 +109,16 @@ fn check_rank<S: Equations + ?Sized>(
     gm: &DMatrix<f64>,
     t: f64,
 ) -> Result<(), EngineError> {
+    check_rows_rank(sys, gm, &(0..gm.nrows()).collect::<Vec<_>>(), t)
+}
+
+/// Refuses redundant rows: `gm` (the system's rows `rows`) must have full row rank.
+pub(super) fn check_rows_rank<S: Equations + ?Sized>(
+    sys: &S,
+    gm: &DMatrix<f64>,
+    rows: &[usize],
+    t: f64,
+) -> Result<(), EngineError> {
     let m = gm.nrows();
     let svd = gm.transpose().svd(false, true);
     let smax = svd.singular_values.amax();
@@ -118,7 +139,8 @@ fn check_rank<S: Equations + ?Sized>(
         message: format!(
             "redundant constraints at t = {t} s: joint(s) {} fix the same motion twice; \
              remove one or free a direction",
-            sys.joints_of_rows(&weak).join(", ")
+            sys.joints_of_rows(&weak.iter().map(|&i| rows[i]).collect::<Vec<_>>())
+                .join(", ")
         ),
     })
 }

@@ -6,13 +6,15 @@
 pub(crate) mod codec;
 pub(crate) mod dense_output;
 pub(crate) mod generalized_alpha;
+pub(crate) mod given_start;
 pub(crate) mod initial;
 pub(crate) mod iteration_matrix;
 pub(crate) mod newton;
 
 pub use generalized_alpha::{iteration_scaling, GaState, Stepper};
 pub(crate) use generalized_alpha::{Controller, MatrixPoint, Memory, SplitReason};
-pub use initial::initial_state;
+pub use given_start::{given_start, CoordinateStart};
+pub use initial::{initial_state, initial_state_from};
 pub(crate) use iteration_matrix::Scaling;
 pub use iteration_matrix::{IterationMatrix, LinearSolver};
 

@@ -8,11 +8,13 @@
 //! reference, read in one place.
 
 pub mod files;
+mod joint_start;
 mod limits;
 pub mod matrix_file;
 mod planar;
 pub mod rules;
 mod size;
+pub use size::TABLE_PARAMETER_ROWS;
 mod space;
 mod validate;
 pub mod xyz;
@@ -548,6 +550,26 @@ pub struct JointSpec {
     /// A drive of the joint's coordinate (revolute and prismatic joints).
     #[serde(default)]
     pub drive: Option<DriveSpec>,
+    /// The joint's coordinate and rate at the start (revolute and prismatic joints without a
+    /// motion drive): the bodies are placed to meet them, and move at the speed given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<JointInitialSpec>,
+}
+
+/// A joint's start: its coordinate and its rate (each optional). Another joint's coordinate
+/// stays where the bodies are placed and its rate at 0, as far as the joints and the values
+/// given allow (in a closed loop the others follow); values they cannot all meet are refused.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct JointInitialSpec {
+    /// The joint coordinate at the start, as `<joint>.angle` (revolute, rad) or
+    /// `<joint>.position` (prismatic, m) reads it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
+    /// Joint angular speed (revolute, rad/s) or sliding velocity (prismatic, m/s) at the start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f64>,
 }
 
 /// How a joint constrains its two frames.

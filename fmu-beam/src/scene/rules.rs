@@ -522,6 +522,20 @@ pub(crate) const MOTION_CONTINUOUS: Rule = rule(
     Any,
     Schema::None,
 );
+pub(crate) const JOINT_INITIAL_KIND: Rule = rule(
+    "joint_initial_kind",
+    &["joint[].initial"],
+    "only a revolute or prismatic joint has a coordinate to start from",
+    Any,
+    Schema::None,
+);
+pub(crate) const JOINT_INITIAL_MOTION: Rule = rule(
+    "joint_initial_motion",
+    &["joint[].initial"],
+    "a joint with a motion drive starts where its law does: give no initial position or speed",
+    Any,
+    Schema::None,
+);
 pub(crate) const LOAD_FRAME: Rule = rule(
     "load_frame",
     &["load[].frame"],
@@ -1071,6 +1085,8 @@ pub const RULES: &[Rule] = &[
     WELD_NO_DRIVE,
     SPHERICAL_NO_DRIVE,
     MOTION_CONTINUOUS,
+    JOINT_INITIAL_KIND,
+    JOINT_INITIAL_MOTION,
     LAW,
     LAW_PARAMETER,
     TABLE_ROWS,

@@ -5,6 +5,11 @@
 
 use super::{JointKind, Scene};
 
+/// A law's table offers its rows' times and values as FMU parameters up to this many rows; a
+/// longer one (a measured profile) offers none, so that it does not flood the unit with
+/// variables.
+pub const TABLE_PARAMETER_ROWS: usize = 16;
+
 /// Bytes of one number (f64).
 const F64: u64 = 8;
 
@@ -101,14 +106,26 @@ impl Scene {
             .saturating_add(m.saturating_mul(n).saturating_mul(F64))
             .saturating_add(frame_bytes);
         // parameters and outputs of each part, generously: a beam's section, material, damping
-        // and its outputs; a body's position, rotation and angle; a joint's drive parameters,
-        // inputs and outputs; a load's inputs and the accelerations of its frame
+        // and its outputs; a body's mass, inertia, centre of mass, position, rotation and angle;
+        // a joint's drive parameters, inputs and outputs; a load's force, torque and scale law,
+        // or its inputs and the accelerations of its frame; two per row of a law's table
+        let table_rows: u64 = self
+            .joints
+            .iter()
+            .filter_map(|j| j.drive.as_ref().map(|d| &d.law))
+            .chain(self.loads.iter().filter_map(|l| l.scale.as_ref()))
+            .filter_map(|law| law.table.as_ref())
+            .map(|t| t.len())
+            .filter(|&rows| rows <= TABLE_PARAMETER_ROWS)
+            .map(|rows| rows as u64)
+            .fold(0u64, u64::saturating_add);
         let variables = 64u64
             .saturating_add((self.beams.len() as u64).saturating_mul(40))
             .saturating_add(shape)
-            .saturating_add(bodies.saturating_mul(16))
+            .saturating_add(bodies.saturating_mul(24))
             .saturating_add((self.joints.len() as u64).saturating_mul(24))
-            .saturating_add((self.loads.len() as u64).saturating_mul(24));
+            .saturating_add((self.loads.len() as u64).saturating_mul(24))
+            .saturating_add(table_rows.saturating_mul(2));
         Size {
             coordinates: n,
             constraints: m,

@@ -251,6 +251,7 @@ impl Scene {
                 ));
             }
             ck.finite(&format!("{field}.axis_angle"), j.axis_angle)?;
+            super::joint_start::validate_start(&ck, j, &field)?;
             if let Some(d) = &j.drive {
                 if j.kind == JointKind::Weld {
                     return Err(ck.fail(

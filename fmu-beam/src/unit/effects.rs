@@ -438,12 +438,20 @@ fn auto(scene: &Scene) -> Resolution {
     ));
     let (bandwidth, source) = excitation(scene);
     let still = non_rotating(scene);
+    // a revolute joint's fastest drive law, or the speed it starts at
     let spin = scene
         .joints
         .iter()
         .filter(|j| j.kind == JointKind::Revolute)
-        .filter_map(|j| j.drive.as_ref().filter(|d| d.kind == DriveKind::Motion))
-        .map(|d| law_max_rate(&d.law))
+        .map(|j| {
+            let driven = j
+                .drive
+                .as_ref()
+                .filter(|d| d.kind == DriveKind::Motion)
+                .map_or(0.0, |d| law_max_rate(&d.law));
+            let start = j.initial.as_ref().and_then(|i| i.speed).unwrap_or(0.0);
+            driven.max(start.abs())
+        })
         .fold(0.0, f64::max);
     // the axial force of each beam, from a rigid-body run (only where a beam could need it)
     let axial = if scene

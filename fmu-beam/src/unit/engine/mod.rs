@@ -11,6 +11,7 @@ mod model;
 mod outputs;
 mod parameters;
 mod setting;
+mod start;
 mod state;
 mod validity;
 
@@ -381,7 +382,11 @@ impl Engine {
                     };
                 }
             }
-            let state = integrator::initial_state(&system, self.start_time, &settings)?;
+            let t0 = self.start_time;
+            let state = match start::given(&scene, &self.effects, &system, t0)? {
+                Some((q, v)) => integrator::initial_state_from(&system, t0, &settings, q, v)?,
+                None => integrator::initial_state(&system, t0, &settings)?,
+            };
             let (joint_index, body_index) = match &system {
                 Mechanics::Planar(sys) => (
                     scene

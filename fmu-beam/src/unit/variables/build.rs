@@ -1,11 +1,14 @@
 //! The variables of a scene, in value-reference order: parameters (world, solver, beams,
-//! drives), inputs, then outputs (beams, shapes, joints, bodies, energy, solver, input loads'
+//! joints' starts, drives, rigid bodies, loads), inputs, then outputs (beams, shapes, joints, bodies, energy, solver, input loads'
 //! frames), each kind by its own function; only the variables of effects that are on.
 //!
 //! Over 600 lines on purpose: every variable a unit can offer, one function per kind in value-
 //! reference order; the list reads best whole.
 
-use super::{Binding, Causality, Initial, OutputKind, ParamTarget, VarType, Variability, Variable};
+use super::{
+    Binding, Causality, Initial, LawOf, LawParam, OutputKind, ParamTarget, VarType, Variability,
+    Variable,
+};
 use crate::scene::Scene;
 use crate::unit::effects::Effects;
 
@@ -15,7 +18,10 @@ pub(super) fn variables(scene: &Scene, effects: &Effects) -> Vec<Variable> {
     world_parameters(&mut t, scene, effects);
     solver_parameters(&mut t, scene);
     beam_parameters(&mut t, scene, effects);
+    joint_parameters(&mut t, scene);
     drive_parameters(&mut t, scene);
+    body_parameters(&mut t, scene);
+    load_parameters(&mut t, scene);
     inputs(&mut t, scene);
     beam_outputs(&mut t, scene, effects);
     shape_outputs(&mut t, scene, effects);
@@ -438,10 +444,41 @@ fn beam_parameters(t: &mut Builder, scene: &Scene, effects: &Effects) {
     }
 }
 
-/// Each drive's law parameters.
-fn drive_parameters(t: &mut Builder, scene: &Scene) {
+/// Each joint's start, where the scene gives it: `<joint>.initial.position`, `.speed`.
+fn joint_parameters(t: &mut Builder, scene: &Scene) {
     use ParamTarget as T;
-    use Variability as V;
+    for (i, j) in scene.joints.iter().enumerate() {
+        let Some(start) = &j.initial else { continue };
+        let (what, units) = if j.kind == crate::scene::JointKind::Prismatic {
+            ("position along the axis", ["m", "m/s"])
+        } else {
+            ("angle", ["rad", "rad/s"])
+        };
+        if let Some(v) = start.position {
+            t.real_param(
+                format!("{}.initial.position", j.name),
+                T::JointInitialPosition(i),
+                units[0],
+                v,
+                Variability::Fixed,
+                &format!("Joint {what} at the start (the bodies are placed to meet it)"),
+            );
+        }
+        if let Some(v) = start.speed {
+            t.real_param(
+                format!("{}.initial.speed", j.name),
+                T::JointInitialSpeed(i),
+                units[1],
+                v,
+                Variability::Fixed,
+                &format!("Rate of the joint {what} at the start"),
+            );
+        }
+    }
+}
+
+/// Each drive's law parameters (a law read from an input has only its input).
+fn drive_parameters(t: &mut Builder, scene: &Scene) {
     for (i, j) in scene.joints.iter().enumerate() {
         let Some(d) = &j.drive else { continue };
         let unit = match (j.kind, d.kind) {
@@ -450,59 +487,187 @@ fn drive_parameters(t: &mut Builder, scene: &Scene) {
             (_, crate::scene::DriveKind::Motion) => "rad",
             (_, crate::scene::DriveKind::Effort) => "N.m",
         };
-        let law = &d.law;
-        let n = &j.name;
-        if law.law != "input" {
-            if let Some(v) = law.value {
+        if d.law.law != "input" {
+            law_parameters(
+                t,
+                &format!("{}.drive", j.name),
+                &d.law,
+                LawOf::Drive(i),
+                unit,
+            );
+        }
+    }
+}
+
+/// The numbers of a time law as parameters `<prefix>.value`, `.omega`, …, a table's rows as
+/// `<prefix>.table.t[k]` and `<prefix>.table.value[k]` (a table of at most
+/// [`crate::scene::TABLE_PARAMETER_ROWS`] rows); `unit` is the unit of its values.
+fn law_parameters(
+    t: &mut Builder,
+    prefix: &str,
+    law: &crate::scene::LawSpec,
+    of: LawOf,
+    unit: &'static str,
+) {
+    use LawParam as L;
+    use ParamTarget::Law;
+    let fixed = Variability::Fixed;
+    let what = match of {
+        LawOf::Drive(_) => "Drive law",
+        LawOf::LoadScale(_) => "Load scale law",
+    };
+    for (field, p, u, v, desc) in [
+        ("value", L::Value, unit, law.value, "value or final value"),
+        (
+            "omega",
+            L::Omega,
+            "rad/s",
+            law.omega,
+            "spin-up's final angular speed",
+        ),
+        (
+            "ramp_time",
+            L::RampTime,
+            "s",
+            law.ramp_time,
+            "spin-up's ramp duration T",
+        ),
+        (
+            "time_constant",
+            L::TimeConstant,
+            "s",
+            law.time_constant,
+            "exponential's time constant",
+        ),
+        (
+            "until",
+            L::Until,
+            "s",
+            law.until,
+            "the law is zero after this time",
+        ),
+    ] {
+        if let Some(v) = v {
+            t.real_param(
+                format!("{prefix}.{field}"),
+                Law(of, p),
+                u,
+                v,
+                fixed,
+                &format!("{what}: {desc}"),
+            );
+        }
+    }
+    let rows = law
+        .table
+        .iter()
+        .filter(|t| t.len() <= crate::scene::TABLE_PARAMETER_ROWS)
+        .flatten();
+    for (k, row) in rows.enumerate() {
+        t.real_param(
+            format!("{prefix}.table.t[{}]", k + 1),
+            Law(of, L::TableTime(k)),
+            "s",
+            row[0],
+            fixed,
+            &format!("{what}: time of table row {}", k + 1),
+        );
+        t.real_param(
+            format!("{prefix}.table.value[{}]", k + 1),
+            Law(of, L::TableValue(k)),
+            unit,
+            row[1],
+            fixed,
+            &format!("{what}: value of table row {}", k + 1),
+        );
+    }
+}
+
+/// Each rigid body's mass, moments of inertia about its centre of mass and centre of mass.
+fn body_parameters(t: &mut Builder, scene: &Scene) {
+    use ParamTarget as T;
+    let fixed = Variability::Fixed;
+    let xyz = axes(scene);
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let n = &b.name;
+        t.real_param(
+            format!("{n}.mass"),
+            T::BodyMass(i),
+            "kg",
+            b.mass,
+            fixed,
+            "Mass",
+        );
+        if scene.is_3d() {
+            for (k, c) in xyz.iter().enumerate() {
                 t.real_param(
-                    format!("{n}.drive.value"),
-                    T::DriveValue(i),
-                    unit,
-                    v,
-                    V::Fixed,
-                    "Drive law: value or amplitude",
+                    format!("{n}.inertia.{c}"),
+                    T::BodyInertia(i, k),
+                    "kg.m2",
+                    b.inertia[k],
+                    fixed,
+                    &format!("Principal moment of inertia about the centre of mass, body axis {c}"),
                 );
             }
-        }
-        if let Some(v) = law.omega {
+        } else {
             t.real_param(
-                format!("{n}.drive.omega"),
-                T::DriveOmega(i),
-                "rad/s",
-                v,
-                V::Fixed,
-                "Spin-up law: final angular speed",
+                format!("{n}.inertia"),
+                T::BodyInertia(i, 2),
+                "kg.m2",
+                b.inertia[2],
+                fixed,
+                "Moment of inertia about the centre of mass (about z)",
             );
         }
-        if let Some(v) = law.ramp_time {
+        for (k, c) in xyz.iter().enumerate() {
             t.real_param(
-                format!("{n}.drive.ramp_time"),
-                T::DriveRampTime(i),
-                "s",
-                v,
-                V::Fixed,
-                "Spin-up law: duration T of the ramp",
+                format!("{n}.com.{c}"),
+                T::BodyCom(i, k),
+                "m",
+                b.com[k],
+                fixed,
+                &format!("Centre of mass in the body frame, body axis {c}"),
             );
         }
-        if let Some(v) = law.time_constant {
+    }
+}
+
+/// Each load's force and torque (named as the inputs of a load with `input = true` are) and
+/// its scale law's numbers; a load read from inputs has only its inputs.
+fn load_parameters(t: &mut Builder, scene: &Scene) {
+    use ParamTarget as T;
+    let fixed = Variability::Fixed;
+    for (i, l) in scene.loads.iter().enumerate().filter(|(_, l)| !l.input) {
+        let n = &l.name;
+        let (f, m) = (l.force, l.torque);
+        let force = "Force, world axes";
+        let torque = "Torque, world axes";
+        let planar = [
+            ("fx", T::LoadForce(i, 0), "N", f[0], force),
+            ("fy", T::LoadForce(i, 1), "N", f[1], force),
+            ("torque", T::LoadTorque(i, 2), "N.m", m[2], "Torque about z"),
+        ];
+        let spatial = [
+            ("fx", T::LoadForce(i, 0), "N", f[0], force),
+            ("fy", T::LoadForce(i, 1), "N", f[1], force),
+            ("fz", T::LoadForce(i, 2), "N", f[2], force),
+            ("tx", T::LoadTorque(i, 0), "N.m", m[0], torque),
+            ("ty", T::LoadTorque(i, 1), "N.m", m[1], torque),
+            ("tz", T::LoadTorque(i, 2), "N.m", m[2], torque),
+        ];
+        let parts: &[_] = if scene.is_3d() { &spatial } else { &planar };
+        for &(what, target, unit, v, desc) in parts {
             t.real_param(
-                format!("{n}.drive.time_constant"),
-                T::DriveTimeConstant(i),
-                "s",
+                format!("{n}.{what}"),
+                target,
+                unit,
                 v,
-                V::Fixed,
-                "Exponential law: time constant",
+                fixed,
+                &format!("Load on {}: {desc} ({what})", l.frame),
             );
         }
-        if let Some(v) = law.until {
-            t.real_param(
-                format!("{n}.drive.until"),
-                T::DriveUntil(i),
-                "s",
-                v,
-                V::Fixed,
-                "The drive law is zero after this time",
-            );
+        if let Some(scale) = &l.scale {
+            law_parameters(t, &format!("{n}.scale"), scale, LawOf::LoadScale(i), "1");
         }
     }
 }

@@ -116,12 +116,51 @@ pub enum ParamTarget {
     BeamRayleighAlpha(usize),
     BeamRayleighBeta(usize),
     BeamTipDisplacement(usize),
-    /// A parameter of a joint's drive law.
-    DriveValue(usize),
-    DriveOmega(usize),
-    DriveRampTime(usize),
-    DriveTimeConstant(usize),
-    DriveUntil(usize),
+    /// The mass of a rigid body (scene body index).
+    BodyMass(usize),
+    /// A principal moment of inertia of a rigid body about its centre of mass: (body, axis),
+    /// axis 2 (about z) in a planar scene.
+    BodyInertia(usize, usize),
+    /// A coordinate (body, axis) of a rigid body's centre of mass in its body frame.
+    BodyCom(usize, usize),
+    /// A world component (load, axis) of a load's force, of a load that is not an input.
+    LoadForce(usize, usize),
+    /// A world component (load, axis) of a load's torque (axis 2 only in a planar scene).
+    LoadTorque(usize, usize),
+    /// A parameter of a time law: a joint's drive law or a load's scale.
+    Law(LawOf, LawParam),
+    /// The coordinate of scene joint `usize` at the start (`joint.initial.position`).
+    JointInitialPosition(usize),
+    /// The rate of scene joint `usize` at the start (`joint.initial.speed`).
+    JointInitialSpeed(usize),
+}
+
+/// Whose time law a [`ParamTarget::Law`] parameter sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LawOf {
+    /// The drive law of scene joint `usize`.
+    Drive(usize),
+    /// The scale law of scene load `usize`.
+    LoadScale(usize),
+}
+
+/// Which number of a time law a [`ParamTarget::Law`] parameter sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LawParam {
+    /// `value`: a constant's value, an exponential's final value.
+    Value,
+    /// `omega`: a spin-up's final angular speed.
+    Omega,
+    /// `ramp_time`: a spin-up's ramp duration.
+    RampTime,
+    /// `time_constant`: an exponential's time constant.
+    TimeConstant,
+    /// `until`: the law is zero after it.
+    Until,
+    /// The time of row `usize` (from 0) of a `table`.
+    TableTime(usize),
+    /// The value of row `usize` (from 0) of a `table`.
+    TableValue(usize),
 }
 
 /// What an output or calculated parameter reports.
@@ -286,6 +325,8 @@ pub const UNITS: &[UnitDef] = &[
     unit("N.m", 1, 2, -2, 0),
     unit("J", 1, 2, -2, 0),
     unit("1/s", 0, 0, -1, 0),
+    unit("kg", 1, 0, 0, 0),
+    unit("kg.m2", 1, 2, 0, 0),
 ];
 
 /// All variables of a scene, in value-reference order (vr = index; unique over all types).
