@@ -10,6 +10,7 @@
 pub mod files;
 mod limits;
 pub mod matrix_file;
+mod placement;
 mod planar;
 pub mod rules;
 mod size;
@@ -20,6 +21,7 @@ pub mod xyz;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub use placement::{show, show_length, JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
 pub use validate::SceneError;
@@ -544,6 +546,12 @@ pub struct JointSpec {
     /// A drive of the joint's coordinate (revolute and prismatic joints).
     #[serde(default)]
     pub drive: Option<DriveSpec>,
+    /// The two frames may be apart at t = 0: the unit moves the parts together at
+    /// initialization (only their frames, never deforming a beam) and logs which part it moved
+    /// and by how much. Without it, frames further apart than 1e-6 of the longest beam are
+    /// refused (rule `joint_gap`), since a placement error would go unnoticed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub assemble: bool,
 }
 
 /// How a joint constrains its two frames.
@@ -715,12 +723,15 @@ impl Scene {
             })?;
         let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        for (i, b) in scene.beams.iter_mut().enumerate() {
+        let paths: Vec<String> = (0..scene.beams.len())
+            .map(|i| scene.path_of(validate::Part::Beam, i))
+            .collect();
+        for (path, b) in paths.iter().zip(scene.beams.iter_mut()) {
             // a packaged scene carries the text already
             if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
                 let refuse = |e: files::FileRefusal| SceneError::File {
                     origin: origin.clone(),
-                    field: format!("beam[{i}].matrix_file"),
+                    field: format!("{path}.matrix_file"),
                     file: limits::abbreviate(&format!("{file:?}"), 200),
                     rule: e.to_string(),
                 };

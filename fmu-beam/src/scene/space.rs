@@ -5,7 +5,7 @@
 
 use super::planar::unit;
 use super::rules::{self as r, Rule};
-use super::validate::{Checker, SceneError};
+use super::validate::{Checker, Part, SceneError};
 use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
 use crate::scene::matrix_file;
 
@@ -41,7 +41,8 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     }
     zero("world.gravity[2]", s.world.gravity[2], PLANE)?;
     for (i, b) in s.beams.iter().enumerate() {
-        let f = |n: &str| format!("beam[{i}].{n}");
+        let path = s.path_of(Part::Beam, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("position[2]"), b.position[2], PLANE)?;
         none(&f("axis"), b.axis.is_some(), &r::ONLY_3D_FIELD)?;
         none(&f("normal"), b.normal.is_some(), &r::ONLY_3D_FIELD)?;
@@ -57,7 +58,8 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
-        let f = |n: &str| format!("body[{i}].{n}");
+        let path = s.path_of(Part::Body, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("position[2]"), b.position[2], PLANE)?;
         zero(&f("com[2]"), b.com[2], PLANE)?;
         for (name, p) in &b.frames {
@@ -72,14 +74,16 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, j) in s.joints.iter().enumerate() {
-        let f = |n: &str| format!("joint[{i}].{n}");
+        let path = s.path_of(Part::Joint, i);
+        let f = |n: &str| format!("{path}.{n}");
         none(&f("axis"), j.axis.is_some(), &r::ONLY_3D_FIELD)?;
         if j.kind == JointKind::Spherical {
             return Err(ck.fail(&r::SPHERICAL, &f("type"), "\"spherical\""));
         }
     }
     for (i, l) in s.loads.iter().enumerate() {
-        let f = |n: &str| format!("load[{i}].{n}");
+        let path = s.path_of(Part::Load, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("force[2]"), l.force[2], PLANE)?;
         for k in 0..2 {
             zero(&f(&format!("torque[{k}]")), l.torque[k], &r::PLANAR_TORQUE)?;
@@ -108,7 +112,8 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     };
     for (i, b) in s.beams.iter().enumerate() {
-        let f = |n: &str| format!("beam[{i}].{n}");
+        let path = s.path_of(Part::Beam, i);
+        let f = |n: &str| format!("{path}.{n}");
         let axis = match b.axis {
             Some(a) => direction(ck, &f("axis"), a)?,
             None => [b.angle.cos(), b.angle.sin(), 0.0],
@@ -168,7 +173,8 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, j) in s.joints.iter().enumerate() {
-        let f = |n: &str| format!("joint[{i}].{n}");
+        let path = s.path_of(Part::Joint, i);
+        let f = |n: &str| format!("{path}.{n}");
         if let Some(a) = j.axis {
             direction(ck, &f("axis"), a)?;
         }

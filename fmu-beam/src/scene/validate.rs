@@ -135,7 +135,45 @@ pub(super) fn is_identifier(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// The kinds of named parts of a scene, as messages name them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Part {
+    Beam,
+    Body,
+    Joint,
+    Load,
+}
+
 impl Scene {
+    /// How a message names part `i` of a kind: by the name the user gave it (`joint "elbow"`)
+    /// when that is an identifier of at most [`r::MAX_NAME_LENGTH`] characters that no other
+    /// part of the kind has, else by its index (`joint[5]`). A field follows it:
+    /// `joint "elbow".frames[0]`.
+    pub(crate) fn path_of(&self, kind: Part, i: usize) -> String {
+        let (word, names): (&str, Vec<&str>) = match kind {
+            Part::Beam => ("beam", self.beams.iter().map(|b| b.name.as_str()).collect()),
+            Part::Body => (
+                "body",
+                self.bodies.iter().map(|b| b.name.as_str()).collect(),
+            ),
+            Part::Joint => (
+                "joint",
+                self.joints.iter().map(|j| j.name.as_str()).collect(),
+            ),
+            Part::Load => ("load", self.loads.iter().map(|l| l.name.as_str()).collect()),
+        };
+        match names.get(i) {
+            Some(name)
+                if is_identifier(name)
+                    && name.chars().count() <= r::MAX_NAME_LENGTH
+                    && names.iter().filter(|n| *n == name).count() == 1 =>
+            {
+                format!("{word} \"{name}\"")
+            }
+            _ => format!("{word}[{i}]"),
+        }
+    }
+
     pub(crate) fn validate(&self, origin: &str) -> Result<(), SceneError> {
         let ck = Checker { origin };
         super::limits::parts(&ck, self)?;
@@ -181,11 +219,12 @@ impl Scene {
             return Err(ck.fail(&r::A_BEAM, "beam", "[]"));
         }
         for (i, b) in self.beams.iter().enumerate() {
-            validate_beam(&ck, b, i, self.is_3d())?;
+            let path = self.path_of(Part::Beam, i);
+            validate_beam(&ck, b, &path, self.is_3d())?;
             if self.beams[..i].iter().any(|o| o.name == b.name) {
                 return Err(ck.fail(
                     &r::BEAM_NAMES_UNIQUE,
-                    &format!("beam[{i}].name"),
+                    &format!("{path}.name"),
                     format!("{:?}", b.name),
                 ));
             }
@@ -193,31 +232,31 @@ impl Scene {
         super::limits::size(&ck, self)?;
         validate_effects(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
-            validate_body(&ck, b, i, self.is_3d())?;
+            validate_body(&ck, b, &self.path_of(Part::Body, i), self.is_3d())?;
         }
         let mut names: Vec<(&str, String)> = Vec::new();
         let all = self
             .beams
             .iter()
             .enumerate()
-            .map(|(i, b)| (&b.name, format!("beam[{i}].name")))
+            .map(|(i, b)| (&b.name, format!("{}.name", self.path_of(Part::Beam, i))))
             .chain(
                 self.bodies
                     .iter()
                     .enumerate()
-                    .map(|(i, b)| (&b.name, format!("body[{i}].name"))),
+                    .map(|(i, b)| (&b.name, format!("{}.name", self.path_of(Part::Body, i)))),
             )
             .chain(
                 self.joints
                     .iter()
                     .enumerate()
-                    .map(|(i, j)| (&j.name, format!("joint[{i}].name"))),
+                    .map(|(i, j)| (&j.name, format!("{}.name", self.path_of(Part::Joint, i)))),
             )
             .chain(
                 self.loads
                     .iter()
                     .enumerate()
-                    .map(|(i, l)| (&l.name, format!("load[{i}].name"))),
+                    .map(|(i, l)| (&l.name, format!("{}.name", self.path_of(Part::Load, i)))),
             );
         for (name, field) in all {
             super::limits::name_fits(&ck, &field, name)?;
@@ -230,7 +269,7 @@ impl Scene {
             names.push((name, field));
         }
         for (i, j) in self.joints.iter().enumerate() {
-            let field = format!("joint[{i}]");
+            let field = self.path_of(Part::Joint, i);
             for (k, f) in j.frames.iter().enumerate() {
                 if !self.frame_exists(f) {
                     return Err(ck.fail(
@@ -267,7 +306,7 @@ impl Scene {
             }
         }
         for (i, l) in self.loads.iter().enumerate() {
-            let field = format!("load[{i}]");
+            let field = self.path_of(Part::Load, i);
             if !self.frame_exists(&l.frame) {
                 return Err(ck.fail(
                     &r::LOAD_FRAME,
@@ -293,7 +332,40 @@ impl Scene {
                 }
             }
         }
-        super::space::validate_space(&ck, self)
+        super::space::validate_space(&ck, self)?;
+        self.validate_placement(&ck)
+    }
+
+    /// Every joint's frames meet at t = 0 ([`super::placement`]), unless it asks to be
+    /// assembled.
+    fn validate_placement(&self, ck: &Checker) -> Result<(), SceneError> {
+        for g in self.joint_gaps() {
+            let j = &self.joints[g.joint];
+            if j.assemble {
+                continue;
+            }
+            let across = if j.kind == JointKind::Prismatic {
+                " across the sliding axis"
+            } else {
+                ""
+            };
+            return Err(ck.fail_with(
+                &r::JOINT_GAP,
+                &format!("{}.frames", self.path_of(Part::Joint, g.joint)),
+                format!("{:?}", j.frames),
+                &format!(
+                    ": at t = 0 {:?} is at {} m and {:?} at {} m, {} m apart{across} \
+                     ({} m allowed)",
+                    j.frames[0],
+                    super::placement::show(g.at[0]),
+                    j.frames[1],
+                    super::placement::show(g.at[1]),
+                    super::placement::show_length(g.gap),
+                    super::placement::show_length(self.gap_allowed()),
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn frame_exists(&self, frame: &str) -> bool {
@@ -330,7 +402,7 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
         if !on("flexibility") && b.initial.tip_displacement != 0.0 {
             return Err(ck.fail(
                 &r::DEFORMED_NEEDS_FLEXIBILITY,
-                &format!("beam[{i}].initial.tip_displacement"),
+                &format!("{}.initial.tip_displacement", scene.path_of(Part::Beam, i)),
                 b.initial.tip_displacement,
             ));
         }
@@ -346,8 +418,8 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<(), SceneError> {
-    let f = |name: &str| format!("beam[{i}].{name}");
+fn validate_beam(ck: &Checker, b: &BeamSpec, path: &str, three: bool) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{path}.{name}");
     super::limits::name_fits(ck, &f("name"), &b.name)?;
     if !is_identifier(&b.name) {
         return Err(ck.fail(&r::SCENE_NAME, &f("name"), format!("{:?}", b.name)));
@@ -555,8 +627,13 @@ fn validate_section(
     Ok(())
 }
 
-fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Result<(), SceneError> {
-    let f = |name: &str| format!("body[{i}].{name}");
+fn validate_body(
+    ck: &Checker,
+    b: &RigidBodySpec,
+    path: &str,
+    three: bool,
+) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{path}.{name}");
     ck.non_negative(&f("mass"), b.mass)?;
     for k in 0..3 {
         ck.non_negative(&f(&format!("inertia[{k}]")), b.inertia[k])?;
