@@ -242,3 +242,36 @@ fn messages_name_parts_by_their_names_or_by_index_when_the_name_cannot() {
     ));
     assert_eq!(field, "joint \"elbow\".frames[1]");
 }
+
+#[test]
+fn a_planar_vector_in_a_3d_scene_is_refused_and_a_spatial_one_in_a_planar_scene() {
+    let spatial = |position: &str| {
+        format!(
+            r#"
+name = "s"
+dimensions = 3
+[[beam]]
+name = "blade"
+length = 2.0
+elements = 2
+position = {position}
+material = {{ rho = 2700.0, E = 7e10, G = 2.6e10 }}
+section = {{ shape = "rectangle", a = 0.02, b = 0.01 }}
+"#
+        )
+    };
+    Scene::from_toml_str(&spatial("[0.0, 0.0, 0.0]"), "s.toml").unwrap();
+    let (field, rule, code) = refusal(&spatial("[0.0, 0.0]"));
+    assert_eq!(
+        (field.as_str(), code),
+        ("beam \"blade\".position", "spatial_vector")
+    );
+    assert!(rule.contains("3 components"), "{rule}");
+    // a planar scene takes [x, y, 0] (the packaged form) but no z
+    Scene::from_toml_str(&arm("[0.5, 0.0, 0.0]", ""), "arm.toml").unwrap();
+    let (field, _, code) = refusal(&arm("[0.5, 0.0, 0.1]", ""));
+    assert_eq!(
+        (field.as_str(), code),
+        ("beam \"lower\".position[2]", "in_plane")
+    );
+}

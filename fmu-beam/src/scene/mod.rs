@@ -24,7 +24,7 @@ use std::path::Path;
 pub use placement::{show, show_length, JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
-pub use validate::SceneError;
+pub use validate::{part_path, SceneError};
 
 /// The default number of space dimensions of a scene.
 fn two() -> u8 {
@@ -108,12 +108,16 @@ pub enum Formulation {
     Spatial,
 }
 
-/// The world: its gravity field.
+/// The world: the fixed frame every position, angle and direction is given in (origin
+/// `[0, 0, 0]`, right-handed axes x, y, z; a planar scene is its x–y plane, angles about z
+/// counter-clockwise from x; the joint frame `world` is this origin with these axes), and its
+/// gravity field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct World {
-    /// Gravity (world axes): `[gx, gy]` or `[gx, gy, gz]`; no field, no gravity terms.
+    /// Gravity (world axes): `[gx, gy]` or `[gx, gy, gz]`; it says which way is down
+    /// (`[0, -9.81]`: along -y); no field, no gravity terms.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m/s^2")))]
     #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
@@ -298,8 +302,9 @@ pub struct BeamSpec {
     /// to the scene file (format: `fmu-beam/src/scene/matrix_file.rs`); the FMU carries its text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_file: Option<String>,
-    /// The matrix file's text (filled by [`Scene::load`]; written into the packaged scene).
-    #[cfg_attr(feature = "schema", schemars(skip))]
+    /// 3D: the matrix file's text itself, in the same format. Loading the scene (and so the
+    /// packager) fills it from `matrix_file`, so that a packaged scene carries its matrices and a unit
+    /// reads no other file; a scene may also give the text here instead of a `matrix_file`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_text: Option<String>,
     /// The initial deformed state.
@@ -677,6 +682,17 @@ impl Scene {
     /// Parses scene text of at most [`files::MAX_SCENE_BYTES`]; a refusal says where (line,
     /// column) and what the parser expected, never the text around it.
     fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene = Scene::parse_text(text, origin)?;
+        if scene.is_3d() {
+            // the number of components written is gone from the spec structs: read it again
+            let table: toml::Table = toml::from_str(text).unwrap_or_default();
+            scene.check_components(&validate::Checker { origin }, &table)?;
+        }
+        Ok(scene)
+    }
+
+    /// The text as a scene (the spec structs), nothing checked beyond its shape.
+    fn parse_text(text: &str, origin: &str) -> Result<Scene, SceneError> {
         if text.len() as u64 > files::MAX_SCENE_BYTES {
             return Err(SceneError::Io {
                 origin: origin.to_string(),

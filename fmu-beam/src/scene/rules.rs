@@ -771,6 +771,20 @@ pub(crate) const IN_PLANE: Rule = rule(
     Planar,
     Schema::None,
 );
+pub(crate) const SPATIAL_VECTOR: Rule = rule(
+    "spatial_vector",
+    &[
+        "world.gravity",
+        "beam[].position",
+        "body[].position",
+        "body[].com",
+        "body[].frames.<name>",
+        "load[].force",
+    ],
+    "a 3D scene's points and forces have 3 components [x, y, z] ([x, y] is the planar form)",
+    Spatial,
+    Schema::None,
+);
 pub(crate) const PLANAR_INERTIA: Rule = rule(
     "planar_inertia",
     &["body[].inertia[0]", "body[].inertia[1]"],
@@ -877,6 +891,7 @@ pub const RULES: &[Rule] = &[
     STIFFENING_NEEDS_AXIAL,
     SPATIAL_EFFECTS,
     IN_PLANE,
+    SPATIAL_VECTOR,
     TOLERANCE_BELOW_ONE,
     MIN_STEP,
     MAX_STEP,

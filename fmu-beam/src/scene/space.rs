@@ -196,3 +196,61 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     }
     Ok(())
 }
+
+impl Scene {
+    /// A 3D scene's points and forces are written with 3 components: `[x, y]` is the planar
+    /// form, and in a 3D scene it would put the point at z = 0 unasked. `table` is the scene's
+    /// text as TOML.
+    pub(super) fn check_components(
+        &self,
+        ck: &Checker,
+        table: &toml::Table,
+    ) -> Result<(), SceneError> {
+        let two = |v: Option<&toml::Value>| {
+            v.and_then(toml::Value::as_array)
+                .is_some_and(|a| a.len() == 2)
+        };
+        let refuse = |field: String, v: Option<&toml::Value>| {
+            let shown = v.map_or(String::new(), |v| v.to_string());
+            Err(ck.fail(&r::SPATIAL_VECTOR, &field, shown))
+        };
+        let gravity = table.get("world").and_then(|w| w.get("gravity"));
+        if two(gravity) {
+            return refuse("world.gravity".into(), gravity);
+        }
+        let items = |key: &str| -> Vec<toml::Value> {
+            table
+                .get(key)
+                .and_then(toml::Value::as_array)
+                .cloned()
+                .unwrap_or_default()
+        };
+        for (i, b) in items("beam").iter().enumerate() {
+            if two(b.get("position")) {
+                let path = self.path_of(Part::Beam, i);
+                return refuse(format!("{path}.position"), b.get("position"));
+            }
+        }
+        for (i, b) in items("body").iter().enumerate() {
+            let path = self.path_of(Part::Body, i);
+            for key in ["position", "com"] {
+                if two(b.get(key)) {
+                    return refuse(format!("{path}.{key}"), b.get(key));
+                }
+            }
+            let frames = b.get("frames").and_then(toml::Value::as_table);
+            for (name, p) in frames.into_iter().flatten() {
+                if two(Some(p)) {
+                    return refuse(format!("{path}.frames.{name}"), Some(p));
+                }
+            }
+        }
+        for (i, l) in items("load").iter().enumerate() {
+            if two(l.get("force")) {
+                let path = self.path_of(Part::Load, i);
+                return refuse(format!("{path}.force"), l.get("force"));
+            }
+        }
+        Ok(())
+    }
+}
