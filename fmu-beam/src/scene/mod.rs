@@ -10,6 +10,7 @@
 pub mod files;
 mod limits;
 pub mod matrix_file;
+mod paths;
 mod placement;
 mod planar;
 pub mod rules;
@@ -21,10 +22,12 @@ pub mod xyz;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-pub use placement::{show, show_length, JointGap, GAP_TOLERANCE};
+pub use paths::part_path;
+pub(crate) use placement::show_length;
+pub use placement::{JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
-pub use validate::{part_path, SceneError};
+pub use validate::SceneError;
 
 /// The default number of space dimensions of a scene.
 fn two() -> u8 {
@@ -740,7 +743,7 @@ impl Scene {
         let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let paths: Vec<String> = (0..scene.beams.len())
-            .map(|i| scene.path_of(validate::Part::Beam, i))
+            .map(|i| scene.path_of(paths::Part::Beam, i))
             .collect();
         for (path, b) in paths.iter().zip(scene.beams.iter_mut()) {
             // a packaged scene carries the text already

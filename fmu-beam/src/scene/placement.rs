@@ -9,6 +9,9 @@
 //! together; a prismatic joint only across its sliding axis. The relative orientation the
 //! frames have at t = 0 is the one a weld or prismatic joint holds, so it has no mismatch.
 
+use super::paths::Part;
+use super::rules as r;
+use super::validate::{Checker, SceneError};
 use super::{JointKind, JointSpec, Scene};
 
 /// The gap a joint's frames may have at t = 0, relative to the scene's longest beam: 1e-6,
@@ -140,6 +143,38 @@ impl Scene {
         })
     }
 
+    /// Every joint's frames meet at t = 0 ([`super::placement`]), unless it asks to be
+    /// assembled.
+    pub(super) fn validate_placement(&self, ck: &Checker) -> Result<(), SceneError> {
+        for g in self.joint_gaps() {
+            let j = &self.joints[g.joint];
+            if j.assemble {
+                continue;
+            }
+            let across = if j.kind == JointKind::Prismatic {
+                " across the sliding axis"
+            } else {
+                ""
+            };
+            return Err(ck.fail_with(
+                &r::JOINT_GAP,
+                &format!("{}.frames", self.path_of(Part::Joint, g.joint)),
+                format!("{:?}", j.frames),
+                &format!(
+                    ": at t = 0 {:?} is at {} m and {:?} at {} m, {} m apart{across} \
+                     ({} m allowed)",
+                    j.frames[0],
+                    show(g.at[0]),
+                    j.frames[1],
+                    show(g.at[1]),
+                    show_length(g.gap),
+                    show_length(self.gap_allowed()),
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The joints whose frames are further apart at t = 0 than [`Scene::gap_allowed`].
     pub fn joint_gaps(&self) -> Vec<JointGap> {
         let allowed = self.gap_allowed();
@@ -154,7 +189,7 @@ impl Scene {
 
 /// A length for a message: six decimals without trailing zeros (0.3, 0.1), or three
 /// significant digits in exponent form below 1e-3 (2.5e-5).
-pub fn show_length(x: f64) -> String {
+pub(crate) fn show_length(x: f64) -> String {
     if x != 0.0 && x.abs() < 1e-3 {
         let e = format!("{x:.2e}");
         return match e.split_once('e') {
@@ -174,7 +209,7 @@ pub fn show_length(x: f64) -> String {
 }
 
 /// A position for a message: `[0.3, 0, 0]` ([`show_length`] of each).
-pub fn show(p: [f64; 3]) -> String {
+pub(crate) fn show(p: [f64; 3]) -> String {
     format!(
         "[{}, {}, {}]",
         show_length(p[0]),

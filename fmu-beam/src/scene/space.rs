@@ -3,9 +3,10 @@
 //! matrix files valid, and it asks for planar-only features only when its motion is planar
 //! (then it runs with the planar element, [`Scene::planar_reduction`]).
 
+use super::paths::Part;
 use super::planar::unit;
 use super::rules::{self as r, Rule};
-use super::validate::{Checker, Part, SceneError};
+use super::validate::{Checker, SceneError};
 use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
 use crate::scene::matrix_file;
 

@@ -1,5 +1,6 @@
 //! Value rules of a scene. Each error names the file, the field and the rule.
 
+use super::paths::Part;
 use super::rules::{self as r, Rule};
 use super::{
     BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
@@ -135,50 +136,7 @@ pub(super) fn is_identifier(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
-/// How a message names item `i` of a scene's list `word` (`beam`, `body`, `joint`, `load`)
-/// whose items have the given names: by the name the user gave it (`joint "elbow"`) when that
-/// is an identifier of at most [`r::MAX_NAME_LENGTH`] characters that no other item of the list
-/// has, else by its index (`joint[5]`). A field follows it: `joint "elbow".frames[0]`.
-pub fn part_path(word: &str, i: usize, names: &[&str]) -> String {
-    match names.get(i) {
-        Some(name)
-            if is_identifier(name)
-                && name.chars().count() <= r::MAX_NAME_LENGTH
-                && names.iter().filter(|n| *n == name).count() == 1 =>
-        {
-            format!("{word} \"{name}\"")
-        }
-        _ => format!("{word}[{i}]"),
-    }
-}
-
-/// The kinds of named parts of a scene, as messages name them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Part {
-    Beam,
-    Body,
-    Joint,
-    Load,
-}
-
 impl Scene {
-    /// How a message names part `i` of a kind ([`part_path`]).
-    pub(crate) fn path_of(&self, kind: Part, i: usize) -> String {
-        let (word, names): (&str, Vec<&str>) = match kind {
-            Part::Beam => ("beam", self.beams.iter().map(|b| b.name.as_str()).collect()),
-            Part::Body => (
-                "body",
-                self.bodies.iter().map(|b| b.name.as_str()).collect(),
-            ),
-            Part::Joint => (
-                "joint",
-                self.joints.iter().map(|j| j.name.as_str()).collect(),
-            ),
-            Part::Load => ("load", self.loads.iter().map(|l| l.name.as_str()).collect()),
-        };
-        part_path(word, i, &names)
-    }
-
     pub(crate) fn validate(&self, origin: &str) -> Result<(), SceneError> {
         let ck = Checker { origin };
         super::limits::parts(&ck, self)?;
@@ -339,38 +297,6 @@ impl Scene {
         }
         super::space::validate_space(&ck, self)?;
         self.validate_placement(&ck)
-    }
-
-    /// Every joint's frames meet at t = 0 ([`super::placement`]), unless it asks to be
-    /// assembled.
-    fn validate_placement(&self, ck: &Checker) -> Result<(), SceneError> {
-        for g in self.joint_gaps() {
-            let j = &self.joints[g.joint];
-            if j.assemble {
-                continue;
-            }
-            let across = if j.kind == JointKind::Prismatic {
-                " across the sliding axis"
-            } else {
-                ""
-            };
-            return Err(ck.fail_with(
-                &r::JOINT_GAP,
-                &format!("{}.frames", self.path_of(Part::Joint, g.joint)),
-                format!("{:?}", j.frames),
-                &format!(
-                    ": at t = 0 {:?} is at {} m and {:?} at {} m, {} m apart{across} \
-                     ({} m allowed)",
-                    j.frames[0],
-                    super::placement::show(g.at[0]),
-                    j.frames[1],
-                    super::placement::show(g.at[1]),
-                    super::placement::show_length(g.gap),
-                    super::placement::show_length(self.gap_allowed()),
-                ),
-            ));
-        }
-        Ok(())
     }
 
     fn frame_exists(&self, frame: &str) -> bool {
