@@ -69,8 +69,9 @@ pub fn to_toml(
     }
     if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
         // a scene's beams, bodies, joints and loads are named by their names, as the engine does
-        let names: Option<Vec<String>> = PARTS.contains(&path).then(|| {
-            obj.try_iter()
+        let paths: Option<Vec<String>> = PARTS.contains(&path).then(|| {
+            let names: Vec<String> = obj
+                .try_iter()
                 .into_iter()
                 .flatten()
                 .map(|item| {
@@ -79,7 +80,9 @@ pub fn to_toml(
                         .and_then(|n| n.extract::<String>().ok())
                         .unwrap_or_default()
                 })
-                .collect()
+                .collect();
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            fmu_beam::scene::part_paths(path, &names)
         });
         let mut items = Vec::new();
         for (i, item) in obj
@@ -88,11 +91,8 @@ pub fn to_toml(
             .enumerate()
         {
             let item = item.map_err(|e| refuse(e.to_string()))?;
-            let at = match &names {
-                Some(names) => {
-                    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-                    fmu_beam::scene::part_path(path, i, &names)
-                }
+            let at = match paths.as_ref().and_then(|p| p.get(i)) {
+                Some(p) => p.clone(),
                 None => format!("{path}[{i}]"),
             };
             if item.is_none() {

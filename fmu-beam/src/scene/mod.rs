@@ -22,7 +22,7 @@ pub mod xyz;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-pub use paths::part_path;
+pub use paths::{part_path, part_paths};
 pub(crate) use placement::show_length;
 pub use placement::{JointGap, GAP_TOLERANCE};
 pub use size::Size;
@@ -686,10 +686,12 @@ impl Scene {
     /// column) and what the parser expected, never the text around it.
     fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
         let scene = Scene::parse_text(text, origin)?;
-        if scene.is_3d() {
-            // the number of components written is gone from the spec structs: read it again
+        let ck = validate::Checker { origin };
+        // the number of components written is gone from the spec structs: read it again (not
+        // for a scene of too many parts, which validation refuses at once)
+        if scene.is_3d() && limits::parts(&ck, &scene).is_ok() {
             let table: toml::Table = toml::from_str(text).unwrap_or_default();
-            scene.check_components(&validate::Checker { origin }, &table)?;
+            scene.check_components(&ck, &table)?;
         }
         Ok(scene)
     }
@@ -742,15 +744,14 @@ impl Scene {
             })?;
         let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        let paths: Vec<String> = (0..scene.beams.len())
-            .map(|i| scene.path_of(paths::Part::Beam, i))
-            .collect();
-        for (path, b) in paths.iter().zip(scene.beams.iter_mut()) {
+        let names: Vec<String> = scene.beams.iter().map(|b| b.name.clone()).collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        for (i, b) in scene.beams.iter_mut().enumerate() {
             // a packaged scene carries the text already
             if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
                 let refuse = |e: files::FileRefusal| SceneError::File {
                     origin: origin.clone(),
-                    field: format!("{path}.matrix_file"),
+                    field: format!("{}.matrix_file", part_path("beam", i, &names)),
                     file: limits::abbreviate(&format!("{file:?}"), 200),
                     rule: e.to_string(),
                 };
