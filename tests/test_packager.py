@@ -12,10 +12,10 @@ from fmu_util import C1, harness_modes, run_harness
 # (case, edit of the C1 scene text, words the message must name: the field and the rule)
 WRONG_SCENES = [
     ("misspelled_key", ("length = 2.0", "lenght = 2.0"), ["lenght", "unknown field"]),
-    ("negative_length", ("length = 2.0", "length = -2"), ["beam[0].length", "must be positive"]),
-    ("zero_elements", ("elements = 10", "elements = 0"), ["beam[0].elements", "must be at least 1"]),
+    ("negative_length", ("length = 2.0", "length = -2"), ["beam \"beam\".length", "must be positive"]),
+    ("zero_elements", ("elements = 10", "elements = 0"), ["beam \"beam\".elements", "must be at least 1"]),
     ("missing_section", ('section = { shape = "rectangle", a = 0.01, b = 0.01 }\n', ""), ["section", "missing"]),
-    ("nan_length", ("length = 2.0", "length = nan"), ["beam[0].length", "finite"]),
+    ("nan_length", ("length = 2.0", "length = nan"), ["beam \"beam\".length", "finite"]),
     ("bad_tolerance", ("tolerance = 1e-8", "tolerance = 2.0"), ["solver.tolerance", "below 1"]),
 ]
 

@@ -175,20 +175,20 @@ print(json.dumps(out))
 def test_a_wrong_scene_raises_scene_error_naming_the_field(venv, tmp_path):
     out = json.loads(run_in(venv, WRONG))
     negative = out["negative"]
-    assert negative["field"] == "beam[0].length" and negative["rule"] == "must be positive"
-    assert negative["message"] == "<dict>: field `beam[0].length` = -2: must be positive"
+    assert negative["field"] == 'beam "beam".length' and negative["rule"] == "must be positive"
+    assert negative["message"] == '<dict>: field `beam "beam".length` = -2: must be positive'
     assert negative["value"] == "-2" and negative["origin"] == "<dict>" and negative["is_error"]
     assert negative["code"]
-    assert out["typo"]["field"] == "beam[0].lenght"
+    assert out["typo"]["field"] == 'beam "beam".lenght'
     assert "unknown field `lenght`" in out["typo"]["rule"]
-    assert out["object"]["field"] == "joint[0].frames[1]"
+    assert out["object"]["field"] == 'joint "hinge".frames[1]'
     # the command: the packager's message on standard error, exit status 2
     bad = tmp_path / "bad.toml"
     bad.write_text((ROOT / "scenes" / "flexible_pendulum.toml").read_text().replace("length = 0.4", "length = -2"))
     done = subprocess.run([str(venv["root"] / "bin" / "fmu-beam"), "package", str(bad), "-o", str(tmp_path / "x.fmu")],
                           env=venv["env"], capture_output=True, text=True)
     assert done.returncode == 2
-    assert "field `beam[0].length` = -2: must be positive" in done.stderr
+    assert 'field `beam "beam".length` = -2: must be positive' in done.stderr
     assert not (tmp_path / "x.fmu").exists()
 
 

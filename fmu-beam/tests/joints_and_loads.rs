@@ -123,8 +123,9 @@ fn redundant_joints_are_refused_naming_them() {
     );
 }
 
-/// Flange b pinned to a world point 1.5 m away from a 1 m beam clamped at the origin: no
-/// configuration satisfies both joints; refused, naming the joint that stays violated.
+/// Flange b pinned to a world point 1.5 m away from a 1 m beam hinged at the origin: no
+/// configuration satisfies both joints. Validation refuses the 0.5 m gap; asked to assemble it
+/// (`assemble = true`), the unit refuses at initialization, naming the joint that stays violated.
 #[test]
 fn a_mechanism_that_cannot_be_assembled_is_refused_naming_the_joints() {
     let text = r#"
@@ -140,6 +141,7 @@ name = "post"
 mass = 1.0
 inertia = 0.1
 position = [1.5, 0.0]
+frames = { anchor = [-1.5, 0.0] }
 [[joint]]
 name = "hinge"
 type = "revolute"
@@ -147,13 +149,20 @@ frames = ["world", "beam.a"]
 [[joint]]
 name = "post_fixed"
 type = "weld"
-frames = ["world", "post.origin"]
+frames = ["world", "post.anchor"]
 [[joint]]
 name = "reach"
 type = "revolute"
 frames = ["beam.b", "post.origin"]
 "#;
-    let mut e = Engine::new(Scene::from_toml_str(text, "impossible.toml").unwrap());
+    let refused = Scene::from_toml_str(text, "impossible.toml").unwrap_err();
+    assert!(
+        refused.to_string().contains("joint \"reach\".frames")
+            && refused.to_string().contains("0.5 m apart"),
+        "{refused}"
+    );
+    let text = format!("{text}assemble = true\n");
+    let mut e = Engine::new(Scene::from_toml_str(&text, "impossible.toml").unwrap());
     let err = e.exit_initialization().unwrap_err();
     println!("{err}");
     assert!(matches!(err, EngineError::Assembly { .. }));

@@ -73,27 +73,27 @@ fn scene_rules_of_each_dimension_name_the_field() {
         ),
         (
             PLANAR.replace("elements = 2\n", "elements = 2\naxis = [0, 1, 0]\n"),
-            "beam[0].axis",
+            "beam \"beam\".axis",
             "3D scenes",
         ),
         (
             PLANAR.replace("J = 1e-9", "J = 1e-9, Iy = 1e-9"),
-            "beam[0].section.Iy",
+            "beam \"beam\".section.Iy",
             "3D scenes",
         ),
         (
             SPATIAL.replace("Iy = 2e-9, ", ""),
-            "beam[0].section.Iy",
+            "beam \"beam\".section.Iy",
             "required",
         ),
         (
             SPATIAL.replace("It = 1.5e-9", "It = 1.5e-9, J = 1e-9"),
-            "beam[0].section.J",
+            "beam \"beam\".section.J",
             "Iy, Iz and It",
         ),
         (
             SPATIAL.replace(", G = 8e10", ""),
-            "beam[0].material.G",
+            "beam \"beam\".material.G",
             "shear modulus",
         ),
         (
@@ -101,12 +101,12 @@ fn scene_rules_of_each_dimension_name_the_field() {
                 "elements = 2\n",
                 "elements = 2\naxis = [1, 0, 0]\nnormal = [1, 0, 1]\n",
             ),
-            "beam[0].normal",
+            "beam \"beam\".normal",
             "normal to the beam axis",
         ),
         (
             SPATIAL.replace("elements = 2\n", "elements = 2\naxis = [0, 0, 0]\n"),
-            "beam[0].axis",
+            "beam \"beam\".axis",
             "non-zero direction",
         ),
         (
@@ -114,12 +114,12 @@ fn scene_rules_of_each_dimension_name_the_field() {
                 "{SPATIAL}[[joint]]\nname = \"j\"\ntype = \"spherical\"\nframes = [\"world\", \
                  \"beam.a\"]\ndrive = {{ kind = \"motion\", law = \"constant\", value = 1.0 }}\n"
             ),
-            "joint[0].drive",
+            "joint \"j\".drive",
             "spherical",
         ),
         (
             format!("{SPATIAL}geometric_stiffening = true\n[world]\ngravity = [0, 0, -9.81]\n"),
-            "beam[0].geometric_stiffening",
+            "beam \"beam\".geometric_stiffening",
             "planar element only",
         ),
         (
@@ -127,7 +127,7 @@ fn scene_rules_of_each_dimension_name_the_field() {
                 "{SPATIAL}[[load]]\nname = \"l\"\nframe = \"beam.b\"\ninput = true\n\
                  scale = {{ law = \"table\", table = [[0, 0], [1, 1]] }}\n"
             ),
-            "load[0].scale",
+            "load \"l\".scale",
             "input",
         ),
     ];
@@ -141,7 +141,7 @@ fn scene_rules_of_each_dimension_name_the_field() {
     let msg = refused(&format!(
         "{PLANAR}[[load]]\nname = \"l\"\nframe = \"beam.b\"\ntorque = [1, 0, 0]\n"
     ));
-    assert!(msg.contains("load[0].torque[0]"), "{msg}");
+    assert!(msg.contains("load \"l\".torque[0]"), "{msg}");
 }
 
 #[test]
@@ -165,14 +165,14 @@ fn a_bad_matrix_file_is_refused_with_its_line_and_rule() {
     let msg = refused(&scene(&(bad.join("\n") + "\n")));
     println!("{msg}");
     assert!(
-        msg.contains("`beam[0].matrix_file`") && msg.contains("e.txt"),
+        msg.contains("`beam \"beam\".matrix_file`") && msg.contains("e.txt"),
         "{msg}"
     );
     assert!(msg.contains("symmetric"), "{msg}");
     // the scene's length must be the file's
     let msg = refused(&scene(&good).replace("length = 0.2", "length = 0.3"));
     assert!(
-        msg.contains("beam[0].length") && msg.contains("0.2"),
+        msg.contains("beam \"beam\".length") && msg.contains("0.2"),
         "{msg}"
     );
 }

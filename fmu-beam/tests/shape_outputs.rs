@@ -195,7 +195,10 @@ fn shape_points_and_the_outputs_list_decide_what_is_offered() {
         .to_toml_string()
         .replace("name = \"beam\"", "name = \"beam\"\nshape_points = 1");
     let err = Scene::from_toml_str(&text, "one_point.toml").unwrap_err();
-    assert!(err.to_string().contains("beam[0].shape_points"), "{err}");
+    assert!(
+        err.to_string().contains("beam \"beam\".shape_points"),
+        "{err}"
+    );
 }
 
 #[test]

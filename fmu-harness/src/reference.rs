@@ -420,10 +420,11 @@ pub fn scene_reference() -> String {
         "## Rules\n\n\
          Every rule of the validator, in the order it checks them. A refused scene's message \
          names the file, the field, the value and the rule, e.g. \
-         ``scene.toml: field `beam[0].length` = -1: must be positive``. \"schema\" says whether \
+         ``scene.toml: field `beam \"arm\".length` = -1: must be positive`` (a beam, body, joint \
+         or load named by its name, or by its index `beam[0]` where the name cannot). \"schema\" says whether \
          `scenes/scene.schema.json` checks the rule too (an editor flags it as you type); the \
          others need several fields' values or arithmetic, and only `fmu-harness package` sees \
-         them. Fields: `[]` any index, `<name>` any key, `*` every number.\n\n\
+         them. Fields: `[]` any index or part name, `<name>` any key, `*` every number.\n\n\
          | code | scenes | fields | rule | schema |\n|---|---|---|---|---|"
     );
     for r in rules::RULES {

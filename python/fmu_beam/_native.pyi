@@ -18,7 +18,7 @@ class SceneError(Error):
     origin: str
     """The scene file, or '<dict>' / '<string>' (the ``origin`` given)."""
     field: Optional[str]
-    """The field's path, such as 'beam[0].length'; None when the text could not be read."""
+    """The field's path, such as 'beam "arm".length'; None when the text could not be read."""
     value: Optional[str]
     """The value refused, as written."""
     rule: Optional[str]

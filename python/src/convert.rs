@@ -5,6 +5,31 @@ use crate::errors::Refusal;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
+/// The scene's lists whose items have names.
+const PARTS: [&str; 4] = ["beam", "body", "joint", "load"];
+
+/// A field's path whose leading `beam[i]` (or `body`, `joint`, `load`) is named as the engine
+/// names it ([`fmu_beam::scene::part_path`]), from the scene's table.
+pub fn named_path(path: &str, table: &toml::Table) -> String {
+    let Some((word, rest)) = path.split_once('[') else {
+        return path.to_string();
+    };
+    let Some((index, after)) = rest.split_once(']') else {
+        return path.to_string();
+    };
+    let (Ok(i), true) = (index.parse::<usize>(), PARTS.contains(&word)) else {
+        return path.to_string();
+    };
+    let Some(toml::Value::Array(items)) = table.get(word) else {
+        return path.to_string();
+    };
+    let names: Vec<&str> = items
+        .iter()
+        .map(|t| t.get("name").and_then(toml::Value::as_str).unwrap_or(""))
+        .collect();
+    format!("{}{after}", fmu_beam::scene::part_path(word, i, &names))
+}
+
 /// `obj` (found at `path` of the scene) as a TOML value. A key whose value is None is left out
 /// (TOML has no null: the field takes its default); anything that is no number, string,
 /// Boolean, list or mapping (numpy arrays and scalars go through their `tolist()`) is refused
@@ -43,6 +68,22 @@ pub fn to_toml(
             .map_err(|_| refuse("a string that is not valid Unicode".into()));
     }
     if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        // a scene's beams, bodies, joints and loads are named by their names, as the engine does
+        let paths: Option<Vec<String>> = PARTS.contains(&path).then(|| {
+            let names: Vec<String> = obj
+                .try_iter()
+                .into_iter()
+                .flatten()
+                .map(|item| {
+                    item.ok()
+                        .and_then(|d| d.get_item("name").ok())
+                        .and_then(|n| n.extract::<String>().ok())
+                        .unwrap_or_default()
+                })
+                .collect();
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            fmu_beam::scene::part_paths(path, &names)
+        });
         let mut items = Vec::new();
         for (i, item) in obj
             .try_iter()
@@ -50,7 +91,10 @@ pub fn to_toml(
             .enumerate()
         {
             let item = item.map_err(|e| refuse(e.to_string()))?;
-            let at = format!("{path}[{i}]");
+            let at = match paths.as_ref().and_then(|p| p.get(i)) {
+                Some(p) => p.clone(),
+                None => format!("{path}[{i}]"),
+            };
             if item.is_none() {
                 return Err(Box::new(Refusal {
                     message: format!("{origin}: field `{at}`: None in a list"),

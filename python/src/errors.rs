@@ -21,7 +21,7 @@ pyo3::create_exception!(
     Error,
     "A scene refused by the packager's validation. Its message is the packager's; its \
      attributes: `origin` (the file, or '<dict>'), `field` (the field's path such as \
-     'beam[0].length', or None when the text could not be read at all), `value` (as written), \
+     'beam \"arm\".length', or None when the text could not be read at all), `value` (as written), \
      `rule` (what the value breaks, or the parser's message) and `code` (the rule's code in the \
      scene reference, or None)."
 );

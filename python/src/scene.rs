@@ -282,6 +282,16 @@ fn read_matrix_files(
     let Some(toml::Value::Array(beams)) = table.get_mut("beam") else {
         return Ok(());
     };
+    let names: Vec<String> = beams
+        .iter()
+        .map(|t| {
+            t.get("name")
+                .and_then(toml::Value::as_str)
+                .unwrap_or("")
+                .to_string()
+        })
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
     for (i, beam) in beams.iter_mut().enumerate() {
         let toml::Value::Table(b) = beam else {
             continue;
@@ -294,7 +304,10 @@ fn read_matrix_files(
         };
         let path = directory.unwrap_or(Path::new(".")).join(file);
         let text = std::fs::read_to_string(&path).map_err(|e| {
-            let field = format!("beam[{i}].matrix_file");
+            let field = format!(
+                "{}.matrix_file",
+                fmu_beam::scene::part_path("beam", i, &names)
+            );
             let rule = format!("cannot read {}: {e}", path.display());
             Box::new(Refusal {
                 message: format!("{origin}: field `{field}` = {file:?}: {rule}"),
@@ -320,7 +333,7 @@ fn refusal_in_dict(e: &fmu_beam::SceneError, table: &toml::Table) -> Refusal {
     let value = toml::Value::Table(table.clone());
     match serde_path_to_error::deserialize::<_, Scene>(value) {
         Err(err) => {
-            let field = err.path().to_string();
+            let field = crate::convert::named_path(&err.path().to_string(), table);
             // the first line: toml's own `in <table>` after it is what the path says
             let inner = err.inner().to_string();
             let rule = inner.lines().next().unwrap_or_default().to_string();

@@ -419,6 +419,49 @@ fn run_moves_the_tip_from_its_initial_deflection() {
     );
 }
 
+/// Issue 32: where a joint asks for assembly, fmi2ExitInitializationMode returns fmi2OK and
+/// logs (fmi2Warning, `logStatusWarning`) which part it moved and by how much, before any step.
+#[test]
+fn assembly_is_logged_at_initialization() {
+    let scene = SCENE.replace(
+        "initial = { tip_displacement = 0.01 }\n",
+        "[[body]]\nname = \"tip_mass\"\nmass = 0.1\ninertia = 1e-4\nposition = [2.05, 0.0]\n",
+    ) + "[[joint]]\nname = \"glue\"\ntype = \"weld\"\nframes = [\"beam.b\", \"tip_mass.origin\"]\n\
+         assemble = true\n";
+    let res = Resources::new("resources", Some(&scene), Some(GUID));
+    let mut fmu = Fmu::new(&res);
+    fmu.initialize();
+    let log = fmu.log.all();
+    let assembly: Vec<&Message> = log
+        .iter()
+        .filter(|m| m.text().contains("assembly at initialization"))
+        .collect();
+    assert_eq!(assembly.len(), 1, "{log:?}");
+    let m = assembly[0];
+    assert_eq!(
+        (m.status, m.category.as_str()),
+        (fmi2Warning as c_int, "logStatusWarning")
+    );
+    assert!(
+        m.text().contains("joint \"glue\"")
+            && m.text().contains("0.05 m apart")
+            && m.text().contains("body \"tip_mass\" by 0.05 m"),
+        "{}",
+        m.text()
+    );
+    // without the key the same scene is refused at instantiation, naming the joint
+    let refused = scene.replace("assemble = true\n", "");
+    let res = Resources::new("resources", Some(&refused), Some(GUID));
+    let log = Box::<Log>::default();
+    let c = instantiate_raw(Some("x"), fmi2CoSimulation, GUID, &res.uri(), &log, false);
+    assert!(c.is_null());
+    assert!(
+        log.last().contains("joint \"glue\".frames") && log.last().contains("0.05 m apart"),
+        "{}",
+        log.last()
+    );
+}
+
 #[test]
 fn platform_and_version() {
     assert_eq!(

@@ -207,9 +207,12 @@ impl Instance {
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), Fault> {
-        self.engine
-            .exit_initialization()
-            .map_err(|e| self.fail(e))?;
+        let result = self.engine.exit_initialization();
+        // what building the model found (assembly, effects): said at initialization
+        for message in self.engine.take_messages() {
+            self.logger.status(fmi2Status::fmi2Warning, &message);
+        }
+        result.map_err(|e| self.fail(e))?;
         if let Some(report) = self.tolerance_report() {
             self.logger.event(&report);
         }

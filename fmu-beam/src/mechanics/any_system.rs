@@ -41,6 +41,42 @@ impl Mechanics {
     pub fn inputs_mut(&mut self) -> &mut Vec<InputValue> {
         each!(self, s => &mut s.inputs)
     }
+
+    /// How far each body's frame lies from `before` in `after` (coordinates of this system):
+    /// (body name, distance of the frame's origin in m, angle it turned through in rad). A
+    /// substructure's name is its beam's followed by `[i]` (planar) or `.i` (3D).
+    pub fn frame_moves(
+        &self,
+        before: &DVector<f64>,
+        after: &DVector<f64>,
+    ) -> Vec<(String, f64, f64)> {
+        match self {
+            Mechanics::Planar(s) => s
+                .bodies
+                .iter()
+                .zip(&s.offsets)
+                .map(|(b, &o)| {
+                    let d = (after[o] - before[o]).hypot(after[o + 1] - before[o + 1]);
+                    (
+                        b.name().to_string(),
+                        d,
+                        (after[o + 2] - before[o + 2]).abs(),
+                    )
+                })
+                .collect(),
+            Mechanics::Spatial(s, _) => s
+                .bodies
+                .iter()
+                .zip(&s.offsets)
+                .map(|(b, &o)| {
+                    let d = (after.rows(o, 3) - before.rows(o, 3)).norm();
+                    let (p0, p1) = (before.rows(o + 3, 4), after.rows(o + 3, 4));
+                    let cos = (p0.dot(&p1) / (p0.norm() * p1.norm())).abs().min(1.0);
+                    (b.name().to_string(), d, 2.0 * cos.acos())
+                })
+                .collect(),
+        }
+    }
 }
 
 impl Equations for Mechanics {

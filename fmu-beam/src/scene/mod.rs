@@ -11,6 +11,8 @@ pub mod files;
 mod joint_start;
 mod limits;
 pub mod matrix_file;
+mod paths;
+mod placement;
 mod planar;
 pub mod rules;
 mod size;
@@ -22,6 +24,9 @@ pub mod xyz;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub use paths::{part_path, part_paths};
+pub(crate) use placement::show_length;
+pub use placement::{JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
 pub use validate::SceneError;
@@ -112,12 +117,16 @@ pub enum Formulation {
     Spatial,
 }
 
-/// The world: its gravity field.
+/// The world: the fixed frame every position, angle and direction is given in (origin
+/// `[0, 0, 0]`, right-handed axes x, y, z; a planar scene is its x–y plane, angles about z
+/// counter-clockwise from x; the joint frame `world` is this origin with these axes), and its
+/// gravity field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct World {
-    /// Gravity (world axes): `[gx, gy]` or `[gx, gy, gz]`; no field, no gravity terms.
+    /// Gravity (world axes): `[gx, gy]` or `[gx, gy, gz]`; it says which way is down
+    /// (`[0, -9.81]`: along -y); no field, no gravity terms.
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "m/s^2")))]
     #[cfg_attr(feature = "schema", schemars(schema_with = "xyz::schema::point"))]
     #[serde(default, with = "xyz::point")]
@@ -302,8 +311,9 @@ pub struct BeamSpec {
     /// to the scene file (format: `fmu-beam/src/scene/matrix_file.rs`); the FMU carries its text.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_file: Option<String>,
-    /// The matrix file's text (filled by [`Scene::load`]; written into the packaged scene).
-    #[cfg_attr(feature = "schema", schemars(skip))]
+    /// 3D: the matrix file's text itself, in the same format. Loading the scene (and so the
+    /// packager) fills it from `matrix_file`, so that a packaged scene carries its matrices and a unit
+    /// reads no other file; a scene may also give the text here instead of a `matrix_file`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix_text: Option<String>,
     /// The initial deformed state.
@@ -554,6 +564,12 @@ pub struct JointSpec {
     /// motion drive): the bodies are placed to meet them, and move at the speed given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial: Option<JointInitialSpec>,
+    /// The two frames may be apart at t = 0: the unit moves the parts together at
+    /// initialization (only their frames, never deforming a beam) and logs which part it moved
+    /// and by how much. Without it, frames further apart than 1e-6 of the longest beam are
+    /// refused (rule `joint_gap`), since a placement error would go unnoticed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub assemble: bool,
 }
 
 /// A joint's start: its coordinate and its rate (each optional). Another joint's coordinate
@@ -695,6 +711,19 @@ impl Scene {
     /// Parses scene text of at most [`files::MAX_SCENE_BYTES`]; a refusal says where (line,
     /// column) and what the parser expected, never the text around it.
     fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene = Scene::parse_text(text, origin)?;
+        let ck = validate::Checker { origin };
+        // the number of components written is gone from the spec structs: read it again (not
+        // for a scene of too many parts, which validation refuses at once)
+        if scene.is_3d() && limits::parts(&ck, &scene).is_ok() {
+            let table: toml::Table = toml::from_str(text).unwrap_or_default();
+            scene.check_components(&ck, &table)?;
+        }
+        Ok(scene)
+    }
+
+    /// The text as a scene (the spec structs), nothing checked beyond its shape.
+    fn parse_text(text: &str, origin: &str) -> Result<Scene, SceneError> {
         if text.len() as u64 > files::MAX_SCENE_BYTES {
             return Err(SceneError::Io {
                 origin: origin.to_string(),
@@ -741,12 +770,14 @@ impl Scene {
             })?;
         let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
+        let names: Vec<String> = scene.beams.iter().map(|b| b.name.clone()).collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
         for (i, b) in scene.beams.iter_mut().enumerate() {
             // a packaged scene carries the text already
             if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
                 let refuse = |e: files::FileRefusal| SceneError::File {
                     origin: origin.clone(),
-                    field: format!("beam[{i}].matrix_file"),
+                    field: format!("{}.matrix_file", part_path("beam", i, &names)),
                     file: limits::abbreviate(&format!("{file:?}"), 200),
                     rule: e.to_string(),
                 };

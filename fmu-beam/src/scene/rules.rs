@@ -508,6 +508,17 @@ pub(crate) const JOINT_FRAMES_DIFFER: Rule = rule(
     Any,
     Schema::Unique,
 );
+/// Its text quotes [`super::placement::GAP_TOLERANCE`] (a test checks it).
+pub(crate) const JOINT_GAP: Rule = rule(
+    "joint_gap",
+    &["joint[].frames"],
+    "the joint's two frames must meet at t = 0 (a prismatic joint's: on its sliding axis), \
+     within 1e-6 of the longest beam's length: place the parts so that they do, or write \
+     `assemble = true` on the joint to have the unit move them together at initialization \
+     (it logs what it moved)",
+    Any,
+    Schema::None,
+);
 pub(crate) const WELD_NO_DRIVE: Rule = rule(
     "weld_no_drive",
     &["joint[].drive"],
@@ -910,6 +921,20 @@ pub(crate) const IN_PLANE: Rule = rule(
     Planar,
     Schema::None,
 );
+pub(crate) const SPATIAL_VECTOR: Rule = rule(
+    "spatial_vector",
+    &[
+        "world.gravity",
+        "beam[].position",
+        "body[].position",
+        "body[].com",
+        "body[].frames.<name>",
+        "load[].force",
+    ],
+    "a 3D scene's points and forces have 3 components [x, y, z] ([x, y] is the planar form)",
+    Spatial,
+    Schema::None,
+);
 pub(crate) const PLANAR_INERTIA: Rule = rule(
     "planar_inertia",
     &["body[].inertia[0]", "body[].inertia[1]"],
@@ -1025,6 +1050,7 @@ pub const RULES: &[Rule] = &[
     STIFFENING_NEEDS_AXIAL,
     SPATIAL_EFFECTS,
     IN_PLANE,
+    SPATIAL_VECTOR,
     TOLERANCE_BELOW_ONE,
     MIN_STEP,
     MAX_STEP,
@@ -1081,6 +1107,7 @@ pub const RULES: &[Rule] = &[
     FRAME_NAME,
     JOINT_FRAME,
     JOINT_FRAMES_DIFFER,
+    JOINT_GAP,
     SPHERICAL,
     WELD_NO_DRIVE,
     SPHERICAL_NO_DRIVE,
@@ -1103,8 +1130,9 @@ pub fn find(code: &str) -> Option<&'static Rule> {
     RULES.iter().find(|r| r.code == code)
 }
 
-/// Does a field of a message (`beam[2].section.A`) match a pattern of a rule
-/// (`beam[].section.A`)? `[]` matches any index, `<name>` any key, `*` anything.
+/// Does a field of a message (`beam[2].section.A`, `beam "arm".section.A`) match a pattern of a
+/// rule (`beam[].section.A`)? `[]` matches any index, or a part's name in quotes after a space
+/// (how messages name a beam, body, joint or load that has one); `<name>` any key, `*` anything.
 pub fn field_matches(pattern: &str, field: &str) -> bool {
     if pattern == "*" {
         return true;
@@ -1112,7 +1140,18 @@ pub fn field_matches(pattern: &str, field: &str) -> bool {
     let (p, f) = (pattern.as_bytes(), field.as_bytes());
     let (mut i, mut j) = (0, 0);
     while i < p.len() {
-        if p[i..].starts_with(b"[]") {
+        if p[i..].starts_with(b"[]") && f.get(j..).is_some_and(|r| r.starts_with(b" \"")) {
+            j += 2;
+            let start = j;
+            while j < f.len() && (f[j].is_ascii_alphanumeric() || f[j] == b'_') {
+                j += 1;
+            }
+            if j == start || j >= f.len() || f[j] != b'"' {
+                return false;
+            }
+            i += 2;
+            j += 1;
+        } else if p[i..].starts_with(b"[]") {
             if j >= f.len() || f[j] != b'[' {
                 return false;
             }
@@ -1199,6 +1238,10 @@ mod tests {
         quotes(&BEAM_ELEMENTS_MAX, &format!("at most {MAX_BEAM_ELEMENTS}"));
         quotes(&UNIT_MEMORY, &format!("({MAX_UNIT_MEMORY} bytes"));
         quotes(&VARIABLES_MAX, &format!("at most {MAX_VARIABLES} FMU"));
+        quotes(
+            &JOINT_GAP,
+            &format!("within {:e} of", super::super::placement::GAP_TOLERANCE),
+        );
     }
 
     #[test]
@@ -1240,5 +1283,12 @@ mod tests {
             "joint[0].drive.table[3][0]"
         ));
         assert!(field_matches("*", "anything"));
+        assert!(field_matches(
+            "joint[].frames[]",
+            "joint \"elbow\".frames[0]"
+        ));
+        assert!(field_matches("beam[].length", "beam \"arm_2\".length"));
+        assert!(!field_matches("beam[].length", "beam \"\".length"));
+        assert!(!field_matches("beam[].length", "beam \"arm.length"));
     }
 }

@@ -3,6 +3,7 @@
 //! matrix files valid, and it asks for planar-only features only when its motion is planar
 //! (then it runs with the planar element, [`Scene::planar_reduction`]).
 
+use super::paths::Part;
 use super::planar::unit;
 use super::rules::{self as r, Rule};
 use super::validate::{Checker, SceneError};
@@ -41,7 +42,8 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     }
     zero("world.gravity[2]", s.world.gravity[2], PLANE)?;
     for (i, b) in s.beams.iter().enumerate() {
-        let f = |n: &str| format!("beam[{i}].{n}");
+        let path = s.path_of(Part::Beam, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("position[2]"), b.position[2], PLANE)?;
         none(&f("axis"), b.axis.is_some(), &r::ONLY_3D_FIELD)?;
         none(&f("normal"), b.normal.is_some(), &r::ONLY_3D_FIELD)?;
@@ -57,7 +59,8 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
-        let f = |n: &str| format!("body[{i}].{n}");
+        let path = s.path_of(Part::Body, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("position[2]"), b.position[2], PLANE)?;
         zero(&f("com[2]"), b.com[2], PLANE)?;
         for (name, p) in &b.frames {
@@ -72,14 +75,16 @@ fn validate_planar(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, j) in s.joints.iter().enumerate() {
-        let f = |n: &str| format!("joint[{i}].{n}");
+        let path = s.path_of(Part::Joint, i);
+        let f = |n: &str| format!("{path}.{n}");
         none(&f("axis"), j.axis.is_some(), &r::ONLY_3D_FIELD)?;
         if j.kind == JointKind::Spherical {
             return Err(ck.fail(&r::SPHERICAL, &f("type"), "\"spherical\""));
         }
     }
     for (i, l) in s.loads.iter().enumerate() {
-        let f = |n: &str| format!("load[{i}].{n}");
+        let path = s.path_of(Part::Load, i);
+        let f = |n: &str| format!("{path}.{n}");
         zero(&f("force[2]"), l.force[2], PLANE)?;
         for k in 0..2 {
             zero(&f(&format!("torque[{k}]")), l.torque[k], &r::PLANAR_TORQUE)?;
@@ -108,7 +113,8 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     };
     for (i, b) in s.beams.iter().enumerate() {
-        let f = |n: &str| format!("beam[{i}].{n}");
+        let path = s.path_of(Part::Beam, i);
+        let f = |n: &str| format!("{path}.{n}");
         let axis = match b.axis {
             Some(a) => direction(ck, &f("axis"), a)?,
             None => [b.angle.cos(), b.angle.sin(), 0.0],
@@ -168,7 +174,8 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, j) in s.joints.iter().enumerate() {
-        let f = |n: &str| format!("joint[{i}].{n}");
+        let path = s.path_of(Part::Joint, i);
+        let f = |n: &str| format!("{path}.{n}");
         if let Some(a) = j.axis {
             direction(ck, &f("axis"), a)?;
         }
@@ -189,4 +196,62 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
     }
     Ok(())
+}
+
+impl Scene {
+    /// A 3D scene's points and forces are written with 3 components: `[x, y]` is the planar
+    /// form, and in a 3D scene it would put the point at z = 0 unasked. `table` is the scene's
+    /// text as TOML.
+    pub(super) fn check_components(
+        &self,
+        ck: &Checker,
+        table: &toml::Table,
+    ) -> Result<(), SceneError> {
+        let two = |v: Option<&toml::Value>| {
+            v.and_then(toml::Value::as_array)
+                .is_some_and(|a| a.len() == 2)
+        };
+        let refuse = |field: String, v: Option<&toml::Value>| {
+            let shown = v.map_or(String::new(), |v| v.to_string());
+            Err(ck.fail(&r::SPATIAL_VECTOR, &field, shown))
+        };
+        let gravity = table.get("world").and_then(|w| w.get("gravity"));
+        if two(gravity) {
+            return refuse("world.gravity".into(), gravity);
+        }
+        let items = |key: &str| -> Vec<toml::Value> {
+            table
+                .get(key)
+                .and_then(toml::Value::as_array)
+                .cloned()
+                .unwrap_or_default()
+        };
+        for (i, b) in items("beam").iter().enumerate() {
+            if two(b.get("position")) {
+                let path = self.path_of(Part::Beam, i);
+                return refuse(format!("{path}.position"), b.get("position"));
+            }
+        }
+        for (i, b) in items("body").iter().enumerate() {
+            let path = self.path_of(Part::Body, i);
+            for key in ["position", "com"] {
+                if two(b.get(key)) {
+                    return refuse(format!("{path}.{key}"), b.get(key));
+                }
+            }
+            let frames = b.get("frames").and_then(toml::Value::as_table);
+            for (name, p) in frames.into_iter().flatten() {
+                if two(Some(p)) {
+                    return refuse(format!("{path}.frames.{name}"), Some(p));
+                }
+            }
+        }
+        for (i, l) in items("load").iter().enumerate() {
+            if two(l.get("force")) {
+                let path = self.path_of(Part::Load, i);
+                return refuse(format!("{path}.force"), l.get("force"));
+            }
+        }
+        Ok(())
+    }
 }

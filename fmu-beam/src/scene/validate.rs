@@ -1,5 +1,6 @@
 //! Value rules of a scene. Each error names the file, the field and the rule.
 
+use super::paths::Part;
 use super::rules::{self as r, Rule};
 use super::{
     BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
@@ -184,11 +185,12 @@ impl Scene {
             return Err(ck.fail(&r::A_BEAM, "beam", "[]"));
         }
         for (i, b) in self.beams.iter().enumerate() {
-            validate_beam(&ck, b, i, self.is_3d())?;
+            let path = self.path_of(Part::Beam, i);
+            validate_beam(&ck, b, &path, self.is_3d())?;
             if self.beams[..i].iter().any(|o| o.name == b.name) {
                 return Err(ck.fail(
                     &r::BEAM_NAMES_UNIQUE,
-                    &format!("beam[{i}].name"),
+                    &format!("{path}.name"),
                     format!("{:?}", b.name),
                 ));
             }
@@ -196,31 +198,31 @@ impl Scene {
         super::limits::size(&ck, self)?;
         validate_effects(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
-            validate_body(&ck, b, i, self.is_3d())?;
+            validate_body(&ck, b, &self.path_of(Part::Body, i), self.is_3d())?;
         }
         let mut names: Vec<(&str, String)> = Vec::new();
         let all = self
             .beams
             .iter()
             .enumerate()
-            .map(|(i, b)| (&b.name, format!("beam[{i}].name")))
+            .map(|(i, b)| (&b.name, format!("{}.name", self.path_of(Part::Beam, i))))
             .chain(
                 self.bodies
                     .iter()
                     .enumerate()
-                    .map(|(i, b)| (&b.name, format!("body[{i}].name"))),
+                    .map(|(i, b)| (&b.name, format!("{}.name", self.path_of(Part::Body, i)))),
             )
             .chain(
                 self.joints
                     .iter()
                     .enumerate()
-                    .map(|(i, j)| (&j.name, format!("joint[{i}].name"))),
+                    .map(|(i, j)| (&j.name, format!("{}.name", self.path_of(Part::Joint, i)))),
             )
             .chain(
                 self.loads
                     .iter()
                     .enumerate()
-                    .map(|(i, l)| (&l.name, format!("load[{i}].name"))),
+                    .map(|(i, l)| (&l.name, format!("{}.name", self.path_of(Part::Load, i)))),
             );
         for (name, field) in all {
             super::limits::name_fits(&ck, &field, name)?;
@@ -233,7 +235,7 @@ impl Scene {
             names.push((name, field));
         }
         for (i, j) in self.joints.iter().enumerate() {
-            let field = format!("joint[{i}]");
+            let field = self.path_of(Part::Joint, i);
             for (k, f) in j.frames.iter().enumerate() {
                 if !self.frame_exists(f) {
                     return Err(ck.fail(
@@ -271,7 +273,7 @@ impl Scene {
             }
         }
         for (i, l) in self.loads.iter().enumerate() {
-            let field = format!("load[{i}]");
+            let field = self.path_of(Part::Load, i);
             if !self.frame_exists(&l.frame) {
                 return Err(ck.fail(
                     &r::LOAD_FRAME,
@@ -297,7 +299,8 @@ impl Scene {
                 }
             }
         }
-        super::space::validate_space(&ck, self)
+        super::space::validate_space(&ck, self)?;
+        self.validate_placement(&ck)
     }
 
     fn frame_exists(&self, frame: &str) -> bool {
@@ -334,7 +337,7 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
         if !on("flexibility") && b.initial.tip_displacement != 0.0 {
             return Err(ck.fail(
                 &r::DEFORMED_NEEDS_FLEXIBILITY,
-                &format!("beam[{i}].initial.tip_displacement"),
+                &format!("{}.initial.tip_displacement", scene.path_of(Part::Beam, i)),
                 b.initial.tip_displacement,
             ));
         }
@@ -350,8 +353,8 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn validate_beam(ck: &Checker, b: &BeamSpec, i: usize, three: bool) -> Result<(), SceneError> {
-    let f = |name: &str| format!("beam[{i}].{name}");
+fn validate_beam(ck: &Checker, b: &BeamSpec, path: &str, three: bool) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{path}.{name}");
     super::limits::name_fits(ck, &f("name"), &b.name)?;
     if !is_identifier(&b.name) {
         return Err(ck.fail(&r::SCENE_NAME, &f("name"), format!("{:?}", b.name)));
@@ -559,8 +562,13 @@ fn validate_section(
     Ok(())
 }
 
-fn validate_body(ck: &Checker, b: &RigidBodySpec, i: usize, three: bool) -> Result<(), SceneError> {
-    let f = |name: &str| format!("body[{i}].{name}");
+fn validate_body(
+    ck: &Checker,
+    b: &RigidBodySpec,
+    path: &str,
+    three: bool,
+) -> Result<(), SceneError> {
+    let f = |name: &str| format!("{path}.{name}");
     ck.non_negative(&f("mass"), b.mass)?;
     for k in 0..3 {
         ck.non_negative(&f(&format!("inertia[{k}]")), b.inertia[k])?;

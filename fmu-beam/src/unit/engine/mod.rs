@@ -7,6 +7,7 @@
 //! restore and the byte form), [`outputs`] (an output's value from the state), [`parameters`]
 //! (a parameter value into the scene) and [`validity`] (the small-deformation monitor).
 
+mod assembly;
 mod model;
 mod outputs;
 mod parameters;
@@ -97,6 +98,8 @@ pub struct Engine {
     split_reported: Vec<SplitReason>,
     /// Log messages (warnings) for the master, taken by the FMI layer.
     messages: Vec<String>,
+    /// Whether what assembly moved was logged already (a restored state builds again).
+    assembly_reported: bool,
     initialized: bool,
     start_time: f64,
     model: Option<Model>,
@@ -123,6 +126,7 @@ impl Engine {
             warned: vec![false; scene.beams.len()],
             split_reported: Vec::new(),
             messages: Vec::new(),
+            assembly_reported: false,
             scene,
             effects,
             table,
@@ -387,6 +391,13 @@ impl Engine {
                 Some((q, v)) => integrator::initial_state_from(&system, t0, &settings, q, v)?,
                 None => integrator::initial_state(&system, t0, &settings)?,
             };
+            if !self.assembly_reported {
+                use crate::mechanics::multibody::Equations;
+                let placed = system.initial_coordinates()?;
+                self.messages
+                    .extend(assembly::report(&scene, &system, &placed, &state.q));
+                self.assembly_reported = true;
+            }
             let (joint_index, body_index) = match &system {
                 Mechanics::Planar(sys) => (
                     scene
