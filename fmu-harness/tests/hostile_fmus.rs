@@ -162,10 +162,19 @@ fn a_symbolic_link_entry_is_refused_and_never_followed() {
 fn a_binary_that_is_no_fmu_library_of_this_platform_is_refused_before_loading() {
     use fmu_harness::platform::{library_header, Platform};
     let dir = scratch("hostile_binary_kind");
-    let libm = std::fs::read("/lib/x86_64-linux-gnu/libm.so.6").expect("libm, as on every glibc Linux");
+    let libm =
+        std::fs::read("/lib/x86_64-linux-gnu/libm.so.6").expect("libm, as on every glibc Linux");
     let cases: [(&str, Vec<u8>, &str); 3] = [
-        ("text.fmu", b"#!/bin/sh\necho hello\n".to_vec(), "not a 64-bit shared library"),
-        ("dll.fmu", library_header(Platform::Win64, 0), "not a 64-bit shared library"),
+        (
+            "text.fmu",
+            b"#!/bin/sh\necho hello\n".to_vec(),
+            "not a 64-bit shared library",
+        ),
+        (
+            "dll.fmu",
+            library_header(Platform::Win64, 0),
+            "not a 64-bit shared library",
+        ),
         ("libm.fmu", libm, "does not export fmi2Instantiate"),
     ];
     for (name, bytes, words) in cases {

@@ -203,10 +203,7 @@ pub(crate) const LENGTH_RANGE: Rule = rule(
 /// A [`RANGES`] rule.
 pub(crate) const MODULUS_RANGE: Rule = rule(
     "modulus_range",
-    &[
-        "beam[].material.E",
-        "beam[].material.G",
-    ],
+    &["beam[].material.E", "beam[].material.G"],
     "must be at most 1e16 Pa (50 000 times steel's: room for a stiff stand-in for a rigid beam)",
     Any,
     Schema::Within(-1e16, 1e16),
@@ -214,9 +211,7 @@ pub(crate) const MODULUS_RANGE: Rule = rule(
 /// A [`RANGES`] rule.
 pub(crate) const DENSITY_RANGE: Rule = rule(
     "density_range",
-    &[
-        "beam[].material.rho",
-    ],
+    &["beam[].material.rho"],
     "must be at most 1e5 kg/m³ (four times osmium's density)",
     Any,
     Schema::Within(-1e5, 1e5),
@@ -224,9 +219,7 @@ pub(crate) const DENSITY_RANGE: Rule = rule(
 /// A [`RANGES`] rule.
 pub(crate) const MASS_RANGE: Rule = rule(
     "mass_range",
-    &[
-        "body[].mass",
-    ],
+    &["body[].mass"],
     "must be at most 1e9 kg",
     Any,
     Schema::Within(-1e9, 1e9),
@@ -234,9 +227,7 @@ pub(crate) const MASS_RANGE: Rule = rule(
 /// A [`RANGES`] rule.
 pub(crate) const INERTIA_RANGE: Rule = rule(
     "inertia_range",
-    &[
-        "body[].inertia[]",
-    ],
+    &["body[].inertia[]"],
     "must be at most 1e12 kg·m²",
     Any,
     Schema::Within(-1e12, 1e12),
@@ -244,10 +235,7 @@ pub(crate) const INERTIA_RANGE: Rule = rule(
 /// A [`RANGES`] rule.
 pub(crate) const LOAD_RANGE: Rule = rule(
     "load_range",
-    &[
-        "load[].force[]",
-        "load[].torque[]",
-    ],
+    &["load[].force[]", "load[].torque[]"],
     "must be at most 1e12 N (a torque: N·m) in magnitude",
     Any,
     Schema::Within(-1e12, 1e12),

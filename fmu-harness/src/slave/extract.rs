@@ -216,7 +216,9 @@ pub(super) fn binary_loadable(library: &Path, platform: &str) -> Result<(), Slav
         .map_err(|_| refuse("cannot be read or is larger than 256 MiB"))?;
     let kind = crate::platform::Platform::of_library(&bytes);
     let Some(kind) = kind.filter(|k| k.folder() == platform) else {
-        return Err(refuse("is not a 64-bit shared library of this platform (by its header)"));
+        return Err(refuse(
+            "is not a 64-bit shared library of this platform (by its header)",
+        ));
     };
     let missing = crate::engine_library::missing_functions(&bytes, kind)
         .map_err(|_| refuse("has a symbol table that cannot be read"))?;
