@@ -7,6 +7,7 @@
   example's README)."""
 
 import csv
+import re
 import subprocess
 import sys
 
@@ -154,6 +155,14 @@ def test_split_converges_to_the_monolithic_unit(fmu_dir):
         assert t1 < 0.67 * t0, errors
         assert s1 < 0.67 * s0, errors
     assert errors[-1][1] < 0.01 * 4.9e-3, errors
+    # the split slider-crank's README quotes these figures to three digits
+    readme = (ROOT / "examples" / "split_slider_crank" / "README.md").read_text()
+    quoted = re.search(r"max \|crank tip y error\| ([^m]+) m and max \|slider error\| ([^m]+) m",
+                       " ".join(readme.split()))
+    assert quoted, "the README's finer-step figures"
+    for column, text in ((1, quoted.group(1)), (2, quoted.group(2))):
+        figures = [float(x) for x in text.split(",")]
+        assert figures == [float(f"{e[column]:.2e}") for e in errors], (text, errors)
 
 
 def test_gauss_seidel_linear_equals_held_where_one_rod_step_spans_each_communication_step(
