@@ -9,6 +9,7 @@
 
 pub mod files;
 mod joint_start;
+mod laws;
 mod limits;
 pub mod matrix_file;
 mod paths;

@@ -3,8 +3,7 @@
 use super::paths::Part;
 use super::rules::{self as r, Rule};
 use super::{
-    BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, LawSpec, RigidBodySpec, Scene,
-    SectionSpec,
+    BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, RigidBodySpec, Scene, SectionSpec,
 };
 use thiserror::Error;
 
@@ -262,7 +261,7 @@ impl Scene {
                         format!("{:?}", d.kind),
                     ));
                 }
-                validate_law(&ck, &d.law, &format!("{field}.drive"))?;
+                super::laws::validate_law(&ck, &d.law, &format!("{field}.drive"))?;
                 if d.kind == DriveKind::Motion && matches!(d.law.law.as_str(), "exponential") {
                     return Err(ck.fail(
                         &r::MOTION_CONTINUOUS,
@@ -289,7 +288,7 @@ impl Scene {
                 ck.finite(&format!("{field}.torque[{k}]"), l.torque[k])?;
             }
             if let Some(law) = &l.scale {
-                validate_law(&ck, law, &format!("{field}.scale"))?;
+                super::laws::validate_law(&ck, law, &format!("{field}.scale"))?;
                 if l.input || law.law == "input" {
                     return Err(ck.fail(
                         &r::SCALE_NOT_INPUT,
@@ -592,63 +591,6 @@ fn validate_body(
         for k in 0..3 {
             ck.finite(&format!("{field}[{k}]"), p.0[k])?;
         }
-    }
-    Ok(())
-}
-
-pub(super) fn validate_law(ck: &Checker, l: &LawSpec, field: &str) -> Result<(), SceneError> {
-    let f = |name: &str| format!("{field}.{name}");
-    let need = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
-        let x = v.ok_or_else(|| {
-            ck.fail_with(
-                &r::LAW_PARAMETER,
-                &f(name),
-                "missing",
-                &format!(" \"{}\"", l.law),
-            )
-        })?;
-        ck.finite(&f(name), x)?;
-        Ok(x)
-    };
-    if let Some(u) = l.until {
-        ck.non_negative(&f("until"), u)?;
-    }
-    match l.law.as_str() {
-        "constant" => {
-            need(l.value, "value")?;
-        }
-        "exponential" => {
-            need(l.value, "value")?;
-            ck.positive(&f("time_constant"), need(l.time_constant, "time_constant")?)?;
-        }
-        "spin_up" => {
-            need(l.omega, "omega")?;
-            ck.positive(&f("ramp_time"), need(l.ramp_time, "ramp_time")?)?;
-        }
-        "table" => {
-            let t = l.table.as_ref().ok_or_else(|| {
-                ck.fail_with(&r::LAW_PARAMETER, &f("table"), "missing", " \"table\"")
-            })?;
-            if t.len() > r::MAX_TABLE_ROWS {
-                return Err(ck.fail(&r::TABLE_ROWS_MAX, &f("table"), t.len()));
-            }
-            if t.len() < 2 {
-                return Err(ck.fail(&r::TABLE_ROWS, &f("table"), t.len()));
-            }
-            for (k, row) in t.iter().enumerate() {
-                ck.finite(&f(&format!("table[{k}][0]")), row[0])?;
-                ck.finite(&f(&format!("table[{k}][1]")), row[1])?;
-                if k > 0 && row[0] <= t[k - 1][0] {
-                    return Err(ck.fail(&r::TABLE_TIMES, &f(&format!("table[{k}][0]")), row[0]));
-                }
-            }
-        }
-        "input" => {
-            if let Some(v) = l.value {
-                ck.finite(&f("value"), v)?;
-            }
-        }
-        other => return Err(ck.fail(&r::LAW, &f("law"), format!("{other:?}"))),
     }
     Ok(())
 }
