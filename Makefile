@@ -212,18 +212,19 @@ example-split: .venv fmus
 	$(PY) examples/split_slider_crank/study.py
 	$(HARNESS) cosim examples/split_slider_crank/joint.toml -o build/split/joint.csv
 	$(PY) examples/split_slider_crank/joint_fmpy.py -o build/split/joint_fmpy.csv
-	$(PY) examples/split_slider_crank/joint_study.py
+	$(PY) examples/split_slider_crank/joint_study.py --readme
 
 # The lag-hinge rotor split at the hinge (examples/hinged_blade): the joint, the hub inertia swept.
 example-hinge: .venv fmus
 	mkdir -p build/hinged_blade
 	$(HARNESS) cosim examples/hinged_blade/system.toml -o build/hinged_blade/cosim.csv
-	$(PY) examples/hinged_blade/hub_sweep.py
+	$(PY) examples/hinged_blade/hub_sweep.py --readme
 
 # The examples (examples/README.md): the flexible arm under PID control (fmpy script) and the
 # C4 parameter sweep on Dask (a local cluster of 2 workers; see examples/sweep.py --help).
 example-arm: .venv fmus
 	$(PY) examples/flexible_arm_pid/arm_pid.py
+	$(PY) examples/flexible_arm_pid/arm_pid.py --table
 
 example-sweep: .venv fmus
 	$(PY) examples/sweep.py
