@@ -48,6 +48,25 @@ pub struct BeamDamping {
 }
 
 impl BeamDamping {
+    /// The damping of `bodies` (flange a to b) whose reference frame's velocity the first body
+    /// reads through `s_first` and, for a chord frame, the last through `s_last` (folded into
+    /// the first where the beam is one body).
+    pub fn with_reference(
+        alpha: f64,
+        mut bodies: Vec<DampedBody>,
+        mut s_first: DMatrix<f64>,
+        s_last: Option<DMatrix<f64>>,
+    ) -> BeamDamping {
+        if let Some(s_last) = s_last {
+            match bodies.len() {
+                1 => s_first += s_last,
+                n => bodies[n - 1].reference = Some(s_last),
+            }
+        }
+        bodies[0].reference = Some(s_first);
+        BeamDamping { alpha, bodies }
+    }
+
     fn rates<'a>(&self, b: &DampedBody, v: &'a DVector<f64>) -> nalgebra::DVectorView<'a, f64> {
         v.rows(b.offset, b.mass.nrows())
     }

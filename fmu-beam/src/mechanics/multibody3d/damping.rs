@@ -27,7 +27,7 @@ impl System3 {
         }
         let ja = self.map_jacobian(first, &beam.flange_a, q);
         let origin = ja.0;
-        let mut bodies: Vec<DampedBody> = group
+        let bodies: Vec<DampedBody> = group
             .bodies
             .clone()
             .map(|i| {
@@ -55,7 +55,7 @@ impl System3 {
             })
             .collect();
         let mut s_first = ja.1.clone();
-        if beam.frame == FloatingFrame::Pinned {
+        let s_last = if beam.frame == FloatingFrame::Pinned {
             // ω = (ω_a·ĉ) ĉ + c × ċ / |c|², c the chord from root to tip
             let jb = self.map_jacobian(last, &last_beam.flange_b, q);
             let c = jb.0 - origin;
@@ -69,18 +69,16 @@ impl System3 {
                 .copy_from(&(along * rot_a - cross * pos_a));
             let mut s_last = DMatrix::zeros(6, jb.1.ncols());
             s_last.rows_mut(3, 3).copy_from(&(cross * jb.1.rows(0, 3)));
-            let n = bodies.len();
-            if n == 1 {
-                s_first += s_last;
-            } else {
-                bodies[n - 1].reference = Some(s_last);
-            }
-        }
-        bodies[0].reference = Some(s_first);
-        Some(BeamDamping {
-            alpha: beam.rayleigh_alpha,
+            Some(s_last)
+        } else {
+            None
+        };
+        Some(BeamDamping::with_reference(
+            beam.rayleigh_alpha,
             bodies,
-        })
+            s_first,
+            s_last,
+        ))
     }
 
     /// Position of the material point `map` of body `body` and the Jacobian (6 × n_body) of

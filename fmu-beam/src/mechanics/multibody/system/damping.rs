@@ -42,7 +42,7 @@ impl System {
             }
             j
         };
-        let mut bodies: Vec<DampedBody> = group
+        let bodies: Vec<DampedBody> = group
             .bodies
             .clone()
             .map(|i| {
@@ -68,9 +68,12 @@ impl System {
         let ja = jacobian(&root, self.bodies[first].ndof());
         let mut s_first = DMatrix::zeros(3, ja.ncols());
         s_first.rows_mut(0, 2).copy_from(&ja.rows(0, 2));
-        match beam.frame {
+        let s_last = match beam.frame {
             // ω: the rate of the root's tangent
-            FloatingFrame::Tangent => s_first.row_mut(2).copy_from(&ja.row(2)),
+            FloatingFrame::Tangent => {
+                s_first.row_mut(2).copy_from(&ja.row(2));
+                None
+            }
             // ω = c × ċ / |c|², c the chord from root to tip
             FloatingFrame::Pinned => {
                 let tip = FrameState::on_body(
@@ -89,19 +92,15 @@ impl System {
                 let rate_a = chord_rate(&ja);
                 let mut row = s_first.row_mut(2);
                 row -= rate_a;
-                let n = bodies.len();
-                if n == 1 {
-                    s_first += s_last;
-                } else {
-                    bodies[n - 1].reference = Some(s_last);
-                }
+                Some(s_last)
             }
-        }
-        bodies[0].reference = Some(s_first);
-        Some(BeamDamping {
-            alpha: beam.rayleigh_alpha,
+        };
+        Some(BeamDamping::with_reference(
+            beam.rayleigh_alpha,
             bodies,
-        })
+            s_first,
+            s_last,
+        ))
     }
 
     /// The power (W, ≥ 0) the beams' α damping takes out at (q, q').
