@@ -172,6 +172,54 @@ impl Study {
     }
 }
 
+/// The time ladder's most levels, extensions included.
+pub const MAX_TIME_LEVELS: usize = 12;
+
+/// The mesh ladder's most levels (the scene's mesh × 32), extensions included.
+pub const MAX_MESH_LEVELS: usize = 6;
+
+/// A ladder's extrapolation (from its finest unbroken successes), its limit, and each rung's
+/// distance to the limit (its share of the error).
+struct Estimate {
+    ladder: Option<Ladder>,
+    limit: Series,
+    shares: Vec<Option<f64>>,
+}
+
+fn estimate(r: &Runner, rungs: &[Option<usize>], peaks: &[f64], nominal: f64) -> Option<Estimate> {
+    let tail = fine_end(r, rungs);
+    let series: Vec<Series> = tail.iter().filter_map(|&i| r.values(i).cloned()).collect();
+    let ladder = richardson(&series.iter().collect::<Vec<_>>(), peaks, nominal);
+    let limit = match &ladder {
+        Some(l) => l.limit.clone(),
+        None => series.last()?.clone(),
+    };
+    let shares = rungs
+        .iter()
+        .map(|i| {
+            i.and_then(|i| r.values(i))
+                .map(|y| distance(y, &limit, peaks))
+        })
+        .collect();
+    Some(Estimate {
+        ladder,
+        limit,
+        shares,
+    })
+}
+
+/// Whether a ladder of at least two runs has a rung whose share is within `bound`.
+fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -> bool {
+    let Some(&finest) = fine_end(r, rungs).last() else {
+        return false;
+    };
+    let Some(pk) = r.values(finest).map(peaks) else {
+        return false;
+    };
+    estimate(r, rungs, &pk, nominal)
+        .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
+}
+
 /// Runs the study of `scene_path`.
 pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessError> {
     opts.check()?;
@@ -245,10 +293,17 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         stiffening_switched: false,
     };
 
-    // the time ladder, coarse to fine: each halving about doubles the cost
+    // the time ladder, coarse to fine (each halving about doubles the cost); past
+    // `opts.levels` it goes on while no step's share is within half the target
     let mut time_runs: Vec<Option<usize>> = Vec::new();
     let mut last_cost = 0.0;
-    for k in 0..opts.levels {
+    for k in 0..MAX_TIME_LEVELS {
+        if k >= opts.levels
+            && (time_runs.last() == Some(&None)
+                || ladder_meets(&r, &time_runs, TIME_ORDER, opts.target / 2.0))
+        {
+            break;
+        }
         let i = r.run(Role::Time, at(k, 0), 2.0 * last_cost);
         if let Some(i) = i {
             last_cost = r.runs[i].seconds;
@@ -265,21 +320,14 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         .into());
     };
     let peaks = peaks(r.values(finest).unwrap_or(&Vec::new()));
-    let series = |r: &Runner, idx: &[usize]| -> Vec<Series> {
-        idx.iter().filter_map(|&i| r.values(i).cloned()).collect()
+    let Some(Estimate {
+        ladder: time,
+        limit: time_limit,
+        shares: time_shares,
+    }) = estimate(&r, &time_runs, &peaks, TIME_ORDER)
+    else {
+        unreachable!("the time ladder has a successful run")
     };
-    let time_series = series(&r, &time_tail);
-    let time = richardson(&time_series.iter().collect::<Vec<_>>(), &peaks, TIME_ORDER);
-    let time_limit: Series = time
-        .as_ref()
-        .map_or_else(|| time_series[0].clone(), |l| l.limit.clone());
-    let time_shares: Vec<Option<f64>> = time_runs
-        .iter()
-        .map(|i| {
-            i.and_then(|i| r.values(i))
-                .map(|y| distance(y, &time_limit, &peaks))
-        })
-        .collect();
     if time.is_none() {
         r.notes.push(
             "one run of the time ladder succeeded: its time error is not estimated (0)".into(),
@@ -287,9 +335,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     }
 
     // the mesh ladder, at the coarsest step whose time share is within a quarter of the
-    // target (the mesh runs are then settings the choice can take), else the finest
+    // target (the mesh runs are then settings the choice can take), else the finest; past
+    // `opts.mesh_levels` it goes on while no mesh's share is within half the target
     let has_mesh = base.beams.iter().any(refinable);
-    let tail_levels: Vec<usize> = (0..opts.levels)
+    let tail_levels: Vec<usize> = (0..time_runs.len())
         .filter(|&k| time_runs[k].is_some_and(|i| time_tail.contains(&i)))
         .collect();
     let mesh_level = tail_levels
@@ -300,7 +349,13 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     let mut mesh_runs: Vec<Option<usize>> = vec![time_runs[mesh_level]];
     if has_mesh {
         let mut cost = time_runs[mesh_level].map_or(0.0, |i| r.runs[i].seconds);
-        for j in 1..opts.mesh_levels {
+        for j in 1..MAX_MESH_LEVELS {
+            if j >= opts.mesh_levels
+                && (mesh_runs.last() == Some(&None)
+                    || ladder_meets(&r, &mesh_runs, MESH_ORDER, opts.target / 2.0))
+            {
+                break;
+            }
             let i = r.run(Role::Mesh, at(mesh_level, j as u32), 2.5 * cost);
             if let Some(i) = i {
                 cost = r.runs[i].seconds;
@@ -311,29 +366,14 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         r.notes
             .push("the scene has no flexible beam to refine: no mesh ladder".into());
     }
-    let mesh_tail = fine_end(&r, &mesh_runs);
-    let mesh_series = series(&r, &mesh_tail);
-    let mesh = richardson(&mesh_series.iter().collect::<Vec<_>>(), &peaks, MESH_ORDER);
+    let mesh_estimate = estimate(&r, &mesh_runs, &peaks, MESH_ORDER);
+    let mesh = mesh_estimate.as_ref().and_then(|e| e.ladder.clone());
     // the limit: the mesh ladder's, moved by the time ladder's correction at its step
     let base_at_mesh_step = time_runs[mesh_level].and_then(|i| r.values(i)).cloned();
-    let (limit, mesh_limit) = match (&mesh, &base_at_mesh_step) {
-        (Some(m), Some(b)) => (shifted(&m.limit, &time_limit, b), Some(m.limit.clone())),
-        _ => (time_limit.clone(), None),
+    let (limit, mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
+        (Some(m), Some(e), Some(b)) => (shifted(&m.limit, &time_limit, b), e.shares.clone()),
+        _ => (time_limit.clone(), vec![Some(0.0)]),
     };
-    let mesh_shares: Vec<Option<f64>> = (0..opts.mesh_levels.max(1))
-        .map(|j| {
-            let y = mesh_runs
-                .get(j)
-                .copied()
-                .flatten()
-                .and_then(|i| r.values(i))?;
-            match &mesh_limit {
-                Some(l) => Some(distance(y, l, &peaks)),
-                None if j == 0 => Some(0.0),
-                None => None,
-            }
-        })
-        .collect();
     if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
         r.notes.push(
             "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
@@ -441,7 +481,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         start,
         stop: start + n as f64 * comm,
         comm,
-        meshes: (0..opts.mesh_levels.max(1) as u32 + 1)
+        meshes: (0..=MAX_MESH_LEVELS as u32)
             .map(|j| mesh_text(&base, j))
             .collect(),
         runs: r.runs,
