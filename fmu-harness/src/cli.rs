@@ -146,6 +146,13 @@ pub struct AccuracyArgs {
     /// The study's budget: wall seconds (a run predicted to pass it is left out and said).
     #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
     pub max_seconds: f64,
+    /// A reference CSV (time first, on the study's grid; e.g. bench/reference/c4_omega10.csv):
+    /// each run's true error is reported beside its estimate.
+    #[arg(long, requires = "columns")]
+    pub reference: Option<PathBuf>,
+    /// The reference's column for each --output, in the same order.
+    #[arg(long = "column", requires = "reference")]
+    pub columns: Vec<String>,
     /// The folder for accuracy.csv and accuracy.png [default: build/accuracy/<scene name>].
     #[arg(long)]
     pub dir: Option<PathBuf>,
@@ -555,6 +562,7 @@ fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<(), HarnessEr
     o.mesh_levels = args.mesh_levels;
     o.max_runs = args.max_runs;
     o.max_seconds = args.max_seconds;
+    o.reference = args.reference.map(|p| (p, args.columns));
     o.progress = true;
     let study = accuracy::study(&args.scene, &o)?;
     let dir = args

@@ -193,6 +193,18 @@ fn the_chosen_settings_meet_the_target_against_the_exact_answer() {
     }
 }
 
+/// The exact tip deflection as a reference CSV beside the scene.
+fn write_reference(scene: &std::path::Path) -> PathBuf {
+    let times: Vec<f64> = (0..=TIMES).map(|k| k as f64 * 1e-3).collect();
+    let mut text = String::from("t,tip\n");
+    for (t, y) in times.iter().zip(exact_tip(BETA, &times)) {
+        text.push_str(&format!("{t:e},{y:e}\n"));
+    }
+    let p = scene.with_file_name("exact.csv");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
 fn harness(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
         .args(args)
@@ -204,6 +216,7 @@ fn harness(args: &[&str]) -> std::process::Output {
 fn the_command_writes_the_table_the_csv_and_the_chart() {
     let path = write_scene("cli", &scene_text(BETA));
     let dir = path.parent().unwrap().join("out");
+    let reference = write_reference(&path);
     let out = harness(&[
         "accuracy",
         path.to_str().unwrap(),
@@ -215,6 +228,10 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
         "4e-3",
         "--dir",
         dir.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "--column",
+        "tip",
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -228,6 +245,8 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
         "## Cheapest settings for 1e-4",
         "consistent: the estimate holds within 3×",
         "## What limits the error",
+        "Against the reference: true error ",
+        "the target is met",
         "## Cost",
     ] {
         assert!(stdout.contains(part), "no `{part}` in:\n{stdout}");
@@ -235,7 +254,7 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
     let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert!(rows[0].starts_with("run,role,step_s,newton_tolerance,mesh,"));
-    assert!(rows[0].ends_with(",estimated_error,error_beam.tip.deflection"));
+    assert!(rows[0].ends_with(",estimated_error,error_beam.tip.deflection,true_error"));
     // 5 steps, 2 more meshes, the chosen setting (unless a ladder ran it), the finer check,
     // Newton and stiffening (which setting is chosen rests on the runs' measured cost)
     assert!((1 + 10..=1 + 11).contains(&rows.len()), "{csv}");
@@ -243,6 +262,9 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
     assert_eq!(&first[..4], ["1", "time", "4e-3", "1e-8"]);
     let est: f64 = first[9].parse().unwrap();
     assert!((est - 1.43e-3).abs() < 0.05e-3, "{est}");
+    // the exact series, written to 6 digits: the true error of the 4 ms step, 1.425e-3
+    let truth: f64 = first[11].parse().unwrap();
+    assert!((truth - 1.425e-3).abs() < 0.01e-3, "{truth}");
     let png = std::fs::read(dir.join("accuracy.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert_eq!(&png[16..24], [0, 0, 2, 208, 0, 0, 1, 224], "720 × 480");
@@ -254,7 +276,22 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
 fn bad_arguments_are_refused_with_clear_messages() {
     let path = write_scene("bad", &scene_text(BETA));
     let scene = path.to_str().unwrap();
+    let reference = write_reference(&path);
+    let reference = reference.to_str().unwrap();
     for (args, message) in [
+        (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--reference",
+                reference,
+                "--column",
+                "nope",
+            ],
+            "exact.csv: no column nope (it has: t, tip)",
+        ),
         (
             vec!["--output", "beam.nope", "--target", "1e-4"],
             "--output beam.nope: the scene's unit has no real variable of that name (it has: ",

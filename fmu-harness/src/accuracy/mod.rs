@@ -14,6 +14,7 @@ mod options;
 pub mod plot;
 pub mod report;
 mod runner;
+pub mod truth;
 
 use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
 use fmu_beam::{Engine, Scene, VarType};
@@ -94,9 +95,16 @@ pub struct Run {
     pub steps: i64,
     /// Per output, the estimated error (against the study's limit); empty until estimated.
     pub errors: Vec<f64>,
+    /// Per output, the error against `--reference` (empty without one).
+    pub true_errors: Vec<f64>,
 }
 
 impl Run {
+    /// The error against the reference (largest over the outputs), where there is one.
+    pub fn true_error(&self) -> Option<f64> {
+        (!self.true_errors.is_empty()).then(|| self.true_errors.iter().copied().fold(0.0, f64::max))
+    }
+
     /// The estimated error (largest over the outputs), if the run succeeded.
     pub fn error(&self) -> Option<f64> {
         (self.result.is_ok() && !self.errors.is_empty())
@@ -162,6 +170,11 @@ pub struct Study {
 }
 
 impl Study {
+    /// Whether the runs were judged against a reference.
+    pub fn judged(&self) -> bool {
+        self.runs.iter().any(|r| !r.true_errors.is_empty())
+    }
+
     /// The time ladder's step at `level`.
     pub fn step(&self, level: usize) -> f64 {
         self.runs
@@ -255,6 +268,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         .into());
     }
     let n = ((stop - start) / comm).round().max(1.0) as usize;
+    let reference = match &opts.reference {
+        Some((path, columns)) => Some(truth::read(path, columns, start, comm, n)?),
+        None => None,
+    };
     let h0 = opts.step.unwrap_or(comm.max(base.solver.max_step));
     let tol0 = opts
         .newton
@@ -474,7 +491,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         }
     }
     let cpu_seconds = r.runs.iter().map(|x| x.seconds).sum();
-    Ok(Study {
+    let mut study = Study {
         scene: base.name.clone(),
         outputs: opts.outputs.clone(),
         target: opts.target,
@@ -494,5 +511,9 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         notes: r.notes,
         cpu_seconds,
         wall_seconds: r.started.elapsed().as_secs_f64(),
-    })
+    };
+    if let Some(reference) = &reference {
+        truth::judge(&mut study, reference);
+    }
+    Ok(study)
 }

@@ -22,6 +22,8 @@ pub enum AccuracyError {
         value: String,
         rule: &'static str,
     },
+    #[error("--reference {path}: {message}")]
+    Reference { path: String, message: String },
     #[error(
         "no run of the time ladder succeeded (coarsest step {step:e} s; first failure: {first}); \
          try a smaller --step"
@@ -52,6 +54,8 @@ pub struct Options {
     /// The study's own budget: runs, and wall seconds.
     pub max_runs: usize,
     pub max_seconds: f64,
+    /// A reference CSV and its column for each output: each run's true error is reported.
+    pub reference: Option<(std::path::PathBuf, Vec<String>)>,
     /// Draw a progress bar on standard error (when it is a terminal).
     pub progress: bool,
 }
@@ -70,6 +74,7 @@ impl Options {
             mesh_levels: 3,
             max_runs: 30,
             max_seconds: 600.0,
+            reference: None,
             progress: false,
         }
     }
@@ -96,6 +101,18 @@ impl Options {
                 if !(v.is_finite() && v > 0.0) {
                     return bad(name, v.to_string(), "must be a positive number");
                 }
+            }
+        }
+        if let Some((p, cols)) = &self.reference {
+            if cols.len() != self.outputs.len() {
+                return Err(AccuracyError::Reference {
+                    path: p.display().to_string(),
+                    message: format!(
+                        "give one --column per --output ({} outputs, {} columns)",
+                        self.outputs.len(),
+                        cols.len()
+                    ),
+                });
             }
         }
         if !(2..=12).contains(&self.levels) {

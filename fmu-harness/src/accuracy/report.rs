@@ -13,6 +13,9 @@ pub fn csv(study: &Study) -> String {
     for o in &study.outputs {
         let _ = write!(s, ",error_{o}");
     }
+    if study.judged() {
+        s.push_str(",true_error");
+    }
     s.push('\n');
     for (i, r) in study.runs.iter().enumerate() {
         let status = match &r.result {
@@ -35,6 +38,13 @@ pub fn csv(study: &Study) -> String {
         );
         for e in &r.errors {
             let _ = write!(s, ",{e:.4e}");
+        }
+        if study.judged() {
+            let _ = write!(
+                s,
+                ",{}",
+                r.true_error().map_or(String::new(), |e| format!("{e:.4e}"))
+            );
         }
         s.push('\n');
     }
@@ -117,8 +127,14 @@ pub fn markdown(study: &Study) -> String {
     for o in &study.outputs {
         let _ = write!(s, " {o} |");
     }
+    if study.judged() {
+        s.push_str(" true error |");
+    }
     let _ = write!(s, "\n|---|---|---|---|---|---|---|---|");
     for _ in &study.outputs {
+        s.push_str("---|");
+    }
+    if study.judged() {
         s.push_str("---|");
     }
     s.push('\n');
@@ -145,6 +161,11 @@ pub fn markdown(study: &Study) -> String {
         );
         for e in &r.errors {
             let _ = write!(s, " {e:.2e} |");
+        }
+        if let Some(t) = r.true_error() {
+            let _ = write!(s, " {t:.2e} |");
+        } else if study.judged() {
+            s.push_str(" |");
         }
         s.push('\n');
     }
@@ -214,6 +235,17 @@ pub fn markdown(study: &Study) -> String {
                 None => {
                     let _ = writeln!(s, "The finer run did not run (budget or failure).\n");
                 }
+            }
+            if let Some(t) = run.true_error() {
+                let _ = writeln!(
+                    s,
+                    "Against the reference: true error {t:.2e}, estimated {est:.2e} (ratio \
+                     {:.2}), predicted before the run {:.2e} (ratio {:.2}); the target is {}.\n",
+                    est / t,
+                    c.predicted,
+                    c.predicted / t,
+                    if t <= study.target { "met" } else { "NOT met" }
+                );
             }
             let newton = c.newton_share.unwrap_or(0.0);
             let _ = writeln!(

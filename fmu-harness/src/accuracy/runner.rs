@@ -161,6 +161,7 @@ impl Runner<'_> {
             seconds,
             steps,
             errors: Vec::new(),
+            true_errors: Vec::new(),
         });
         self.bar.inc(1);
         Some(self.runs.len() - 1)
