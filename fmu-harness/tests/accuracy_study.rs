@@ -184,7 +184,7 @@ fn the_chosen_settings_meet_the_target_against_the_exact_answer() {
         );
         // and checked against a finer run: the difference the estimate expects
         let (_, d) = c.finer.expect("a finer run");
-        let ratio = d / c.expected_difference(&s);
+        let ratio = d / c.expected_difference;
         assert!((1.0 / 3.0..=3.0).contains(&ratio), "finer check {ratio}");
         println!(
             "target {target:e}: h = {:e}, mesh {}, predicted {:.2e}, true {t:.2e}, finer {ratio:.2}",

@@ -116,8 +116,12 @@ impl Run {
 #[derive(Debug, Clone)]
 pub struct Choice {
     pub setting: Setting,
-    /// Time share + mesh share, before the run.
+    /// Before the run: the norm of its time error (at the scene's mesh) plus its mesh error
+    /// (at the mesh ladder's step), added as functions of time (they may cancel; their norms'
+    /// sum, `time_share + mesh_share`, bounds it).
     pub predicted: f64,
+    /// The difference to the finer run the estimate expects: each error divided by 2^order.
+    pub expected_difference: f64,
     pub time_share: f64,
     pub mesh_share: f64,
     /// CPU seconds predicted from the ladders' runs.
@@ -130,16 +134,6 @@ pub struct Choice {
     pub newton_share: Option<f64>,
     /// The difference when geometric stiffening is switched (or why it could not be).
     pub stiffening_change: Option<Result<f64, String>>,
-}
-
-impl Choice {
-    /// The difference to the finer run that the estimate expects, if it is right: the finer
-    /// run has the error of each share divided by 2^order, the two shares added.
-    pub fn expected_difference(&self, study: &Study) -> f64 {
-        let p = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
-        self.time_share * (1.0 - 0.5f64.powf(p(&study.time, TIME_ORDER)))
-            + self.mesh_share * (1.0 - 0.5f64.powf(p(&study.mesh, MESH_ORDER)))
-    }
 }
 
 /// A finished study.
@@ -158,6 +152,9 @@ pub struct Study {
     pub mesh: Option<Ladder>,
     /// The time ladder's level at which the mesh ladder ran.
     pub mesh_step_level: usize,
+    /// The choice's predicted error times this meets the target ([`SAFETY_OBSERVED`],
+    /// [`SAFETY_ASSUMED`]).
+    pub margin: f64,
     /// Per time level and per mesh level: the estimated shares.
     pub time_shares: Vec<Option<f64>>,
     pub mesh_shares: Vec<Option<f64>>,
@@ -184,6 +181,13 @@ impl Study {
             / 2f64.powi(level as i32)
     }
 }
+
+/// The choice's predicted error times this must meet the target, where every ladder's order
+/// is observed (Roache 1997's factor for three grids or more).
+pub const SAFETY_OBSERVED: f64 = 1.25;
+
+/// The same where an order is assumed (fewer than three runs, or not in the asymptotic range).
+pub const SAFETY_ASSUMED: f64 = 3.0;
 
 /// The time ladder's most levels, extensions included.
 pub const MAX_TIME_LEVELS: usize = 12;
@@ -408,15 +412,51 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         let mj = r.runs[(*mesh_runs.get(j)?)?].seconds;
         Some(c * mj / m0.max(1e-9))
     };
+    // a candidate's error, as a function of time: its time error (at the scene's mesh) plus
+    // its mesh error (at the mesh ladder's step), each weighted; the two may cancel
+    let mesh_limit = mesh_estimate.as_ref().map(|e| e.limit.clone());
+    let error_of = |k: usize, j: usize, wt: f64, wx: f64, r: &Runner| -> Option<Series> {
+        let y = r.values(time_runs[k]?)?;
+        let mut e: Series = y
+            .iter()
+            .zip(&time_limit)
+            .map(|(a, b)| a.iter().zip(b).map(|(u, v)| wt * (u - v)).collect())
+            .collect();
+        if let Some(ml) = &mesh_limit {
+            let z = r.values((*mesh_runs.get(j)?)?)?;
+            for ((o, zo), lo) in e.iter_mut().zip(z).zip(ml) {
+                for ((x, u), v) in o.iter_mut().zip(zo).zip(lo) {
+                    *x += wx * (u - v);
+                }
+            }
+        }
+        Some(e)
+    };
+    // Roache's safety factors of the grid convergence index: 1.25 where every ladder's
+    // order is observed, 3 where one is assumed
+    let observed = |l: &Option<Ladder>| {
+        l.as_ref()
+            .is_some_and(|l| l.source == estimate::OrderSource::Observed)
+    };
+    let margin = if observed(&time) && (observed(&mesh) || !has_mesh || opts.mesh_levels == 1) {
+        SAFETY_OBSERVED
+    } else {
+        SAFETY_ASSUMED
+    };
+    let zero: Series = time_limit.iter().map(|o| vec![0.0; o.len()]).collect();
     let mut best: Option<(usize, usize, f64, f64)> = None;
     for (k, ts) in time_shares.iter().enumerate() {
         for (j, ms) in mesh_shares.iter().enumerate() {
-            let (Some(ts), Some(ms)) = (ts, ms) else {
+            if ts.is_none() || ms.is_none() {
+                continue;
+            }
+            let Some(c) = cost_of(k, j, &r) else { continue };
+            let Some(e) = error_of(k, j, 1.0, 1.0, &r) else {
                 continue;
             };
-            let Some(c) = cost_of(k, j, &r) else { continue };
-            if ts + ms <= opts.target && best.is_none_or(|b| c < b.3) {
-                best = Some((k, j, ts + ms, c));
+            let predicted = distance(&e, &zero, &peaks);
+            if predicted * margin <= opts.target && best.is_none_or(|b| c < b.3) {
+                best = Some((k, j, predicted, c));
             }
         }
     }
@@ -469,9 +509,24 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             } else {
                 None
             };
+            // the finer run has each error divided by 2^order: the difference to expect
+            let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
+            let expected_difference = error_of(
+                k,
+                j,
+                1.0 - 0.5f64.powf(order(&time, TIME_ORDER)),
+                if has_mesh {
+                    1.0 - 0.5f64.powf(order(&mesh, MESH_ORDER))
+                } else {
+                    0.0
+                },
+                &r,
+            )
+            .map_or(f64::NAN, |e| distance(&e, &zero, &peaks));
             choice = Some(Choice {
                 setting,
                 predicted,
+                expected_difference,
                 time_share: time_shares[k].unwrap_or(0.0),
                 mesh_share: mesh_shares[j].unwrap_or(0.0),
                 predicted_seconds,
@@ -505,6 +560,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         time,
         mesh,
         mesh_step_level: mesh_level,
+        margin,
         time_shares,
         mesh_shares,
         choice,

@@ -179,9 +179,11 @@ pub fn markdown(study: &Study) -> String {
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             let _ = writeln!(
                 s,
-                "## Target not met\n\nNo setting of the ladders meets {:.0e}{}. Extend them \
+                "## Target not met\n\nNo setting of the ladders meets {:.0e} with a safety \
+                 factor of {}{}. Extend them \
                  (--levels, --mesh-levels, --step) or raise the budget.\n",
                 study.target,
+                study.margin,
                 best.map_or(String::new(), |(e, r)| format!(
                     " (smallest estimated error {e:.2e}, at h = {:.2e} s, {})",
                     r.setting.step,
@@ -194,12 +196,20 @@ pub fn markdown(study: &Study) -> String {
             let est = run.error().unwrap_or(f64::NAN);
             let _ = writeln!(
                 s,
-                "## Cheapest settings for {:.0e}\n\nA fixed step of {:e} s, Newton's tolerance \
-                 {:.0e}, mesh {}: predicted error {:.2e} (time {:.2e} + mesh {:.2e}), \
+                "## Cheapest settings for {:.0e}\n\nThe cheapest setting whose predicted error \
+                 times {} meets the target (a safety factor: {}). A fixed step of {:e} s, Newton's tolerance \
+                 {:.0e}, mesh {}: predicted error {:.2e} (its time error {:.2e} and mesh error {:.2e} \
+                 added over time), \
                  estimated from its run {est:.2e}, {:.3} CPU s (predicted {:.3}).\n\nIn the \
                  scene: `[solver] adaptive = false`, `max_step = {:e}`, `tolerance = {:.0e}`; \
                  beams: {}.\n",
                 study.target,
+                study.margin,
+                if study.margin < 2.0 {
+                    "every ladder's order observed"
+                } else {
+                    "an order assumed"
+                },
                 c.setting.step,
                 c.setting.newton,
                 mesh_of(study, run),
@@ -215,7 +225,7 @@ pub fn markdown(study: &Study) -> String {
             let _ = writeln!(s, "## How sure\n");
             match c.finer {
                 Some((i, d)) => {
-                    let expected = c.expected_difference(study);
+                    let expected = c.expected_difference;
                     let ratio = d / expected;
                     let verdict = if (1.0 / 3.0..=3.0).contains(&ratio) {
                         "consistent: the estimate holds within 3×"
