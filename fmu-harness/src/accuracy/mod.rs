@@ -471,8 +471,12 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         if let Some(run) = run.filter(|&i| r.values(i).is_some()) {
             let finer_setting = at(k + 1, j as u32 + u32::from(has_mesh));
             let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
+            // a ladder's run at that setting serves (C4: the mesh ladder ran at the step above)
             let finer = r
-                .run(Role::Finer, finer_setting, finer_cost)
+                .runs
+                .iter()
+                .position(|x| x.setting == finer_setting && x.result.is_ok())
+                .or_else(|| r.run(Role::Finer, finer_setting, finer_cost))
                 .and_then(|i| Some((i, r.values(i)?)))
                 .map(|(i, y)| {
                     (

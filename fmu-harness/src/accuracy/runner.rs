@@ -172,11 +172,14 @@ impl Runner<'_> {
     }
 }
 
-/// The finest unbroken run of successes at the fine end of a ladder (indices, coarse to fine).
+/// The finest unbroken run of successes at the fine end of what a ladder ran (indices, coarse
+/// to fine).
 pub(super) fn fine_end(runner: &Runner, ladder: &[Option<usize>]) -> Vec<usize> {
+    // rungs the budget left out (None) come last: they end no tail
     let mut tail: Vec<usize> = ladder
         .iter()
         .rev()
+        .skip_while(|r| r.is_none())
         .map_while(|r| r.filter(|&i| runner.values(i).is_some()))
         .collect();
     tail.reverse();
