@@ -293,6 +293,19 @@ fn bad_arguments_are_refused_with_clear_messages() {
             "exact.csv: no column nope (it has: t, tip)",
         ),
         (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--reference",
+                "/dev/zero",
+                "--column",
+                "tip",
+            ],
+            "--reference /dev/zero: ",
+        ),
+        (
             vec!["--output", "beam.nope", "--target", "1e-4"],
             "--output beam.nope: the scene's unit has no real variable of that name (it has: ",
         ),

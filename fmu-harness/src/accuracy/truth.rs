@@ -6,6 +6,10 @@ use super::estimate::{distances, peaks, Series};
 use super::{AccuracyError, Study};
 use std::path::Path;
 
+/// The largest reference read (bench/reference/'s largest file is 95 kB; a million rows of a
+/// few outputs fit).
+pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
+
 /// The reference's columns `columns`, one per output, on the grid `start + k comm`,
 /// k = 0..=n (the file may go on past it).
 pub fn read(
@@ -19,7 +23,8 @@ pub fn read(
         path: path.display().to_string(),
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    let text = crate::input_file::read_text(path, "the reference", MAX_REFERENCE_BYTES)
+        .map_err(|e| bad(e.to_string()))?;
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let names: Vec<&str> = lines
         .next()
