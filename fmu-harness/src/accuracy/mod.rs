@@ -189,6 +189,9 @@ pub const SAFETY_OBSERVED: f64 = 1.25;
 /// The same where an order is assumed (fewer than three runs, or not in the asymptotic range).
 pub const SAFETY_ASSUMED: f64 = 3.0;
 
+/// Values of one run (grid points × outputs): every run is kept until the estimates are made.
+pub const MAX_VALUES: usize = 1_000_000;
+
 /// The time ladder's most levels, extensions included.
 pub const MAX_TIME_LEVELS: usize = 12;
 
@@ -271,7 +274,17 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         }
         .into());
     }
-    let n = ((stop - start) / comm).round().max(1.0) as usize;
+    let points = ((stop - start) / comm).round().max(1.0);
+    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
+        return Err(AccuracyError::BadOption {
+            name: "comm",
+            value: comm.to_string(),
+            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
+                   is kept for the estimates): give a coarser --comm or a shorter --stop",
+        }
+        .into());
+    }
+    let n = points as usize;
     let reference = match &opts.reference {
         Some((path, columns)) => Some(truth::read(path, columns, start, comm, n)?),
         None => None,
