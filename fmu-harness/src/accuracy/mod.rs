@@ -2,10 +2,12 @@
 //! engine's rlib, no packaging) at a ladder of settings: a time ladder (fixed step h0, h0/2, …
 //! with the Newton tolerance divided by 4 at each halving, so that Newton's error falls as fast
 //! as the step's), then a mesh ladder (every flexible beam's elements, or substructures where it
-//! has them, doubled) at one step of the time ladder. Each run's error on the chosen outputs is
+//! has them, doubled) at one step of the time ladder; each goes on past its asked length while
+//! none of its runs is within half the target. Each run's error on the chosen outputs is
 //! estimated from the runs themselves ([`estimate`]): Richardson's extrapolation of each ladder
 //! with its observed order, the two corrections added to one limit. The cheapest pair (step,
-//! mesh) whose predicted error meets the target is run, checked against a run refined in both,
+//! mesh) whose predicted error (its time and mesh errors added over time) times a safety
+//! factor meets the target is run, checked against a run refined in both,
 //! and probed for Newton's share and for the geometric stiffening's (a choice of physics).
 //! [`report`] writes the table, [`plot`] the work-precision chart.
 
