@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-accuracy example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -202,6 +202,27 @@ bench-peer: $(BENCH_STAMP) release
 	mkdir -p build/bench
 	$(VENV_BENCH)/bin/python bench/peer/sweep.py
 	$(BENCH) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
+
+# The accuracy study checked against the truth (issue 34 item 2): `fmu-harness accuracy` on the
+# shipped C2-C4 scenes at targets 1e-2, 1e-3, 1e-4 with --reference bench/reference/<case>.csv,
+# each study's report in build/accuracy/<case>-<target>.md (its "Against the reference" line:
+# the chosen setting's true error and estimate / true); about 6 min, C2 the most of it.
+ACCURACY_CASES = spin_up_omega10:c4_omega10:beam.tip.deflection:tip_deflection \
+	spin_up_omega4:c4_omega4:beam.tip.deflection:tip_deflection \
+	slider_crank_rigid_crank:c3_rigid:slider.position:slider_position \
+	slider_crank:c3_elastic:slider.position:slider_position \
+	flexible_pendulum_substructured:c2:beam.tip.deflection:tip_deflection
+bench-accuracy: release
+	mkdir -p build/accuracy
+	for c in $(ACCURACY_CASES); do \
+	  IFS=: read scene case output column <<< "$$c"; \
+	  for t in 1e-2 1e-3 1e-4; do \
+	    $(HARNESS) accuracy scenes/$$scene.toml --output $$output --target $$t \
+	      --reference bench/reference/$$case.csv --column $$column --max-seconds 150 \
+	      --dir build/accuracy/$$case-$$t > build/accuracy/$$case-$$t.md || exit 1; \
+	    echo "$$case $$t: $$(grep -o 'Against the reference.*\|No setting.*' build/accuracy/$$case-$$t.md)"; \
+	  done; \
+	done
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).

@@ -1,8 +1,8 @@
-//! The command line: `package`, `explain`, `modes`, `schema`, `reference`, `simulate`, `cosim`
-//! and `animate` (the benchmarks are `fmu-bench`'s, in bench/).
+//! The command line: `package`, `explain`, `modes`, `schema`, `reference`, `simulate`, `cosim`,
+//! `animate` and `accuracy` (the benchmarks are `fmu-bench`'s, in bench/).
 
 use crate::error::HarnessError;
-use crate::{animate, cosim, modes, package, reference, schema, simulate};
+use crate::{accuracy, animate, cosim, modes, package, reference, schema, simulate};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -99,6 +99,63 @@ pub enum Command {
     /// Draw a run as it moved: a self-contained HTML page (time slider, play/pause, speed,
     /// deformation magnification, a 3D view turned with the mouse) and/or an animated GIF.
     Animate(AnimateArgs),
+    /// Study how accurate the scene's outputs are and what accuracy costs: runs the scene at a
+    /// ladder of fixed steps and of meshes, estimates each run's error from the runs
+    /// themselves (Richardson's extrapolation with the observed order), and writes the
+    /// work-precision table (CSV, Markdown on standard output), a chart (PNG), the cheapest
+    /// settings that meet the target, a check of them against a finer run, and what limits
+    /// the error (step, mesh or Newton's tolerance).
+    Accuracy(AccuracyArgs),
+}
+
+/// The options of `accuracy`.
+#[derive(Debug, clap::Args)]
+pub struct AccuracyArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// An output to study (repeat for several; the error is the largest of theirs).
+    #[arg(long = "output", required = true)]
+    pub outputs: Vec<String>,
+    /// The error to meet: max over the grid of |y − y*| / max |y*|.
+    #[arg(long, allow_hyphen_values = true)]
+    pub target: f64,
+    /// Stop time [default: the scene's experiment].
+    #[arg(long, allow_hyphen_values = true)]
+    pub stop: Option<f64>,
+    /// The grid the outputs are compared on [default: the experiment's step_size].
+    #[arg(long, allow_hyphen_values = true)]
+    pub comm: Option<f64>,
+    /// The time ladder's coarsest fixed step [default: the larger of the communication step
+    /// and the scene's max_step].
+    #[arg(long, allow_hyphen_values = true)]
+    pub step: Option<f64>,
+    /// Newton's tolerance at the coarsest step, divided by 4 at each halving [default: the
+    /// smaller of the scene's tolerance and target / 10].
+    #[arg(long, allow_hyphen_values = true)]
+    pub newton: Option<f64>,
+    /// Steps in the time ladder (each half the one before).
+    #[arg(long, default_value_t = 5)]
+    pub levels: usize,
+    /// Meshes in the mesh ladder: the scene's, then each flexible beam's elements (or
+    /// substructures) doubled.
+    #[arg(long, default_value_t = 3)]
+    pub mesh_levels: usize,
+    /// The study's budget: runs.
+    #[arg(long, default_value_t = 30)]
+    pub max_runs: usize,
+    /// The study's budget: wall seconds (a run predicted to pass it is left out and said).
+    #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+    pub max_seconds: f64,
+    /// A reference CSV (time first, on the study's grid; e.g. bench/reference/c4_omega10.csv):
+    /// each run's true error is reported beside its estimate.
+    #[arg(long, requires = "columns")]
+    pub reference: Option<PathBuf>,
+    /// The reference's column for each --output, in the same order.
+    #[arg(long = "column", requires = "reference")]
+    pub columns: Vec<String>,
+    /// The folder for accuracy.csv and accuracy.png [default: build/accuracy/<scene name>].
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
 }
 
 /// Runs one command, writing its report to `out`.
@@ -139,6 +196,7 @@ pub fn run_with_engines(
             write_text(&reference::scene_reference(), output.as_deref(), out)
         }
         Command::Modes { scene, count } => modes_cmd(&scene, count, out),
+        Command::Accuracy(args) => accuracy_cmd(args, out),
     }
 }
 
@@ -492,6 +550,41 @@ fn modes_cmd(scene: &Path, count: usize, out: &mut dyn Write) -> Result<(), Harn
     let f = modes::elastic_frequencies(scene)?;
     out.write_all(modes::report(&f, count).as_bytes())
         .map_err(stdout_err)
+}
+
+/// `accuracy`: runs the study, writes its CSV and PNG, prints the Markdown report.
+fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let mut o = accuracy::Options::new(args.outputs, args.target);
+    o.stop = args.stop;
+    o.comm = args.comm;
+    o.step = args.step;
+    o.newton = args.newton;
+    o.levels = args.levels;
+    o.mesh_levels = args.mesh_levels;
+    o.max_runs = args.max_runs;
+    o.max_seconds = args.max_seconds;
+    o.reference = args.reference.map(|p| (p, args.columns));
+    o.progress = true;
+    let study = accuracy::study(&args.scene, &o)?;
+    let dir = args
+        .dir
+        .unwrap_or_else(|| Path::new("build/accuracy").join(&study.scene));
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| HarnessError::io(&dir, "creating the study's folder", e))?;
+    let csv = dir.join("accuracy.csv");
+    std::fs::write(&csv, accuracy::report::csv(&study))
+        .map_err(|e| HarnessError::io(&csv, "writing the table", e))?;
+    let png = dir.join("accuracy.png");
+    std::fs::write(&png, accuracy::plot::png(&study))
+        .map_err(|e| HarnessError::io(&png, "writing the chart", e))?;
+    write!(
+        out,
+        "{}\nWrote {} and {}.\n",
+        accuracy::report::markdown(&study),
+        csv.display(),
+        png.display()
+    )
+    .map_err(stdout_err)
 }
 
 /// `WIDTHxHEIGHT` in pixels.

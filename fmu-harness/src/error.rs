@@ -78,6 +78,8 @@ pub enum HarnessError {
     Cosim(#[from] crate::cosim::CosimError),
     #[error(transparent)]
     Animate(#[from] crate::animate::AnimateError),
+    #[error(transparent)]
+    Accuracy(#[from] crate::accuracy::AccuracyError),
     #[error("{origin}: {message}")]
     Input { origin: String, message: String },
     #[error(transparent)]

@@ -6,6 +6,7 @@
 //! [`model_description::render`] (the template in `modelDescription-templates/`) →
 //! [`guid::guid`] → [`archive::write_fmu`] (deterministic zip, written atomically).
 
+pub mod accuracy;
 pub mod animate;
 pub mod archive;
 pub mod cli;

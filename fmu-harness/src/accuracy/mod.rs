@@ -1,0 +1,594 @@
+//! `fmu-harness accuracy`: an accuracy study of any scene. The scene runs in process (the
+//! engine's rlib, no packaging) at a ladder of settings: a time ladder (fixed step h0, h0/2, …
+//! with the Newton tolerance divided by 4 at each halving, so that Newton's error falls as fast
+//! as the step's), then a mesh ladder (every flexible beam's elements, or substructures where it
+//! has them, doubled) at one step of the time ladder; each goes on past its asked length while
+//! none of its runs is within half the target. Each run's error on the chosen outputs is
+//! estimated from the runs themselves ([`estimate`]): Richardson's extrapolation of each ladder
+//! with its observed order, the two corrections added to one limit. The cheapest pair (step,
+//! mesh) whose predicted error (its time and mesh errors added over time) times a safety
+//! factor meets the target is run, checked against a run refined in both,
+//! and probed for Newton's share and for the geometric stiffening's (a choice of physics).
+//! [`report`] writes the table, [`plot`] the work-precision chart.
+
+pub mod estimate;
+mod options;
+pub mod plot;
+pub mod report;
+mod runner;
+pub mod truth;
+
+use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
+use fmu_beam::{Engine, Scene, VarType};
+pub use options::{AccuracyError, Options};
+use runner::{fine_end, mesh_text, refinable, Grid, Runner};
+use std::path::Path;
+use std::time::Instant;
+
+/// The generalized-α scheme's order in time (Chung & Hulbert 1993, with α_m, α_f, β, γ from ρ∞).
+pub const TIME_ORDER: f64 = 2.0;
+
+/// The order assumed for the mesh where three levels do not measure it: the lowest that
+/// floating-frame Euler–Bernoulli meshes show on the validation cases (substructured beams:
+/// chord rotations), so that an assumed order overstates rather than understates the error.
+pub const MESH_ORDER: f64 = 2.0;
+
+/// Newton's tolerance is divided by this at each halving of the step (h² like the step's error).
+pub const NEWTON_PER_HALVING: f64 = 4.0;
+
+/// The Newton probe divides the chosen setting's tolerance by this.
+pub const NEWTON_PROBE: f64 = 100.0;
+
+/// Below this, the scheduler's CPU account (in ticks of a few ms) is too coarse to rank runs:
+/// the run's wall time is taken instead.
+pub const COARSE_CPU: f64 = 0.05;
+
+/// What a run is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    Time,
+    Mesh,
+    /// The chosen setting, where no ladder ran it.
+    Chosen,
+    /// The chosen setting refined in step and mesh.
+    Finer,
+    /// The chosen setting with Newton's tolerance / [`NEWTON_PROBE`].
+    Newton,
+    /// The chosen setting with every flexible beam's geometric stiffening switched.
+    Stiffening,
+}
+
+impl Role {
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Time => "time",
+            Role::Mesh => "mesh",
+            Role::Chosen => "chosen",
+            Role::Finer => "finer",
+            Role::Newton => "newton",
+            Role::Stiffening => "stiffening",
+        }
+    }
+}
+
+/// One setting of the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setting {
+    /// The fixed step (s).
+    pub step: f64,
+    /// Newton's tolerance.
+    pub newton: f64,
+    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh.
+    pub mesh: u32,
+    /// Every flexible beam's geometric stiffening switched.
+    pub stiffening_switched: bool,
+}
+
+/// One run of the study.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub role: Role,
+    pub setting: Setting,
+    /// The outputs on the grid, or why the run failed.
+    pub result: Result<Series, String>,
+    /// CPU seconds of the run (this thread's; wall seconds where Linux does not say, or where
+    /// the run is shorter than [`COARSE_CPU`]).
+    pub seconds: f64,
+    pub steps: i64,
+    /// Per output, the estimated error (against the study's limit); empty until estimated.
+    pub errors: Vec<f64>,
+    /// Per output, the error against `--reference` (empty without one).
+    pub true_errors: Vec<f64>,
+}
+
+impl Run {
+    /// The error against the reference (largest over the outputs), where there is one.
+    pub fn true_error(&self) -> Option<f64> {
+        (!self.true_errors.is_empty()).then(|| self.true_errors.iter().copied().fold(0.0, f64::max))
+    }
+
+    /// The estimated error (largest over the outputs), if the run succeeded.
+    pub fn error(&self) -> Option<f64> {
+        (self.result.is_ok() && !self.errors.is_empty())
+            .then(|| self.errors.iter().copied().fold(0.0, f64::max))
+    }
+}
+
+/// The cheapest setting found for the target, and how sure the study is of it.
+#[derive(Debug, Clone)]
+pub struct Choice {
+    pub setting: Setting,
+    /// Before the run: the norm of its time error (at the scene's mesh) plus its mesh error
+    /// (at the mesh ladder's step), added as functions of time (they may cancel; their norms'
+    /// sum, `time_share + mesh_share`, bounds it).
+    pub predicted: f64,
+    /// The difference to the finer run the estimate expects: each error divided by 2^order.
+    pub expected_difference: f64,
+    pub time_share: f64,
+    pub mesh_share: f64,
+    /// CPU seconds predicted from the ladders' runs.
+    pub predicted_seconds: f64,
+    /// Its run's index in [`Study::runs`].
+    pub run: usize,
+    /// The finer run's index, and the difference to it (the study's norm).
+    pub finer: Option<(usize, f64)>,
+    /// The difference to the Newton probe: Newton's share of the error.
+    pub newton_share: Option<f64>,
+    /// The difference when geometric stiffening is switched (or why it could not be).
+    pub stiffening_change: Option<Result<f64, String>>,
+}
+
+/// A finished study.
+#[derive(Debug, Clone)]
+pub struct Study {
+    pub scene: String,
+    pub outputs: Vec<String>,
+    pub target: f64,
+    pub start: f64,
+    pub stop: f64,
+    pub comm: f64,
+    /// The mesh of each level, as text (`beam 10 el.`).
+    pub meshes: Vec<String>,
+    pub runs: Vec<Run>,
+    pub time: Option<Ladder>,
+    pub mesh: Option<Ladder>,
+    /// The time ladder's level at which the mesh ladder ran.
+    pub mesh_step_level: usize,
+    /// The choice's predicted error times this meets the target ([`SAFETY_OBSERVED`],
+    /// [`SAFETY_ASSUMED`]).
+    pub margin: f64,
+    /// Per time level and per mesh level: the estimated shares.
+    pub time_shares: Vec<Option<f64>>,
+    pub mesh_shares: Vec<Option<f64>>,
+    pub choice: Option<Choice>,
+    /// Runs left out by the budget, and other remarks.
+    pub notes: Vec<String>,
+    /// The study's own cost: CPU seconds of its runs, wall seconds.
+    pub cpu_seconds: f64,
+    pub wall_seconds: f64,
+}
+
+impl Study {
+    /// Whether the runs were judged against a reference.
+    pub fn judged(&self) -> bool {
+        self.runs.iter().any(|r| !r.true_errors.is_empty())
+    }
+
+    /// The time ladder's step at `level`.
+    pub fn step(&self, level: usize) -> f64 {
+        self.runs
+            .iter()
+            .find(|r| r.role == Role::Time)
+            .map_or(0.0, |r| r.setting.step)
+            / 2f64.powi(level as i32)
+    }
+}
+
+/// The choice's predicted error times this must meet the target, where every ladder's order
+/// is observed (Roache 1997's factor for three grids or more).
+pub const SAFETY_OBSERVED: f64 = 1.25;
+
+/// The same where an order is assumed (fewer than three runs, or not in the asymptotic range).
+pub const SAFETY_ASSUMED: f64 = 3.0;
+
+/// Values of one run (grid points × outputs): every run is kept until the estimates are made.
+pub const MAX_VALUES: usize = 1_000_000;
+
+/// The time ladder's most levels, extensions included.
+pub const MAX_TIME_LEVELS: usize = 12;
+
+/// The mesh ladder's most levels (the scene's mesh × 32), extensions included.
+pub const MAX_MESH_LEVELS: usize = 6;
+
+/// A ladder's extrapolation (from its finest unbroken successes), its limit, and each rung's
+/// distance to the limit (its share of the error).
+struct Estimate {
+    ladder: Option<Ladder>,
+    limit: Series,
+    shares: Vec<Option<f64>>,
+}
+
+fn estimate(r: &Runner, rungs: &[Option<usize>], peaks: &[f64], nominal: f64) -> Option<Estimate> {
+    let tail = fine_end(r, rungs);
+    let series: Vec<Series> = tail.iter().filter_map(|&i| r.values(i).cloned()).collect();
+    let ladder = richardson(&series.iter().collect::<Vec<_>>(), peaks, nominal);
+    let limit = match &ladder {
+        Some(l) => l.limit.clone(),
+        None => series.last()?.clone(),
+    };
+    let shares = rungs
+        .iter()
+        .map(|i| {
+            i.and_then(|i| r.values(i))
+                .map(|y| distance(y, &limit, peaks))
+        })
+        .collect();
+    Some(Estimate {
+        ladder,
+        limit,
+        shares,
+    })
+}
+
+/// Whether a ladder of at least two runs has a rung whose share is within `bound`.
+fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -> bool {
+    let Some(&finest) = fine_end(r, rungs).last() else {
+        return false;
+    };
+    let Some(pk) = r.values(finest).map(peaks) else {
+        return false;
+    };
+    estimate(r, rungs, &pk, nominal)
+        .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
+}
+
+/// Runs the study of `scene_path`.
+pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessError> {
+    opts.check()?;
+    let base = Scene::load(scene_path)?;
+    {
+        let e = Engine::new(base.clone());
+        let reals: Vec<String> = e
+            .variables()
+            .variables
+            .iter()
+            .filter(|v| v.ty == VarType::Real)
+            .map(|v| v.name.clone())
+            .collect();
+        for o in &opts.outputs {
+            if !reals.contains(o) {
+                return Err(AccuracyError::UnknownOutput {
+                    name: o.clone(),
+                    available: reals,
+                }
+                .into());
+            }
+        }
+    }
+    let start = base.experiment.start_time;
+    let stop = opts.stop.unwrap_or(base.experiment.stop_time);
+    let comm = opts.comm.unwrap_or(base.experiment.step_size);
+    if stop <= start {
+        return Err(AccuracyError::BadOption {
+            name: "stop",
+            value: stop.to_string(),
+            rule: "must be after the experiment's start time",
+        }
+        .into());
+    }
+    let points = ((stop - start) / comm).round().max(1.0);
+    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
+        return Err(AccuracyError::BadOption {
+            name: "comm",
+            value: comm.to_string(),
+            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
+                   is kept for the estimates): give a coarser --comm or a shorter --stop",
+        }
+        .into());
+    }
+    let n = points as usize;
+    let reference = match &opts.reference {
+        Some((path, columns)) => Some(truth::read(path, columns, start, comm, n)?),
+        None => None,
+    };
+    let h0 = opts.step.unwrap_or(comm.max(base.solver.max_step));
+    let tol0 = opts
+        .newton
+        .unwrap_or(base.solver.tolerance.min(opts.target / 10.0))
+        .max(1e-13);
+    let planned = opts.levels + opts.mesh_levels.saturating_sub(1) + 4;
+    let bar = if opts.progress {
+        let b = indicatif::ProgressBar::new(planned as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} runs {elapsed} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let mut r = Runner {
+        base: &base,
+        grid: Grid {
+            outputs: &opts.outputs,
+            start,
+            comm,
+            n,
+        },
+        runs: Vec::new(),
+        started: Instant::now(),
+        max_runs: opts.max_runs,
+        max_seconds: opts.max_seconds,
+        notes: Vec::new(),
+        bar,
+    };
+    let at = |level: usize, mesh: u32| Setting {
+        step: h0 / 2f64.powi(level as i32),
+        newton: (tol0 / NEWTON_PER_HALVING.powi(level as i32)).max(1e-14),
+        mesh,
+        stiffening_switched: false,
+    };
+
+    // the time ladder, coarse to fine (each halving about doubles the cost); past
+    // `opts.levels` it goes on while no step's share is within half the target
+    let mut time_runs: Vec<Option<usize>> = Vec::new();
+    let mut last_cost = 0.0;
+    for k in 0..MAX_TIME_LEVELS {
+        if k >= opts.levels
+            && (time_runs.last() == Some(&None)
+                || ladder_meets(&r, &time_runs, TIME_ORDER, opts.target / 2.0))
+        {
+            break;
+        }
+        let i = r.run(Role::Time, at(k, 0), 2.0 * last_cost);
+        if let Some(i) = i {
+            last_cost = r.runs[i].seconds;
+        }
+        time_runs.push(i);
+    }
+    let time_tail = fine_end(&r, &time_runs);
+    let Some(&finest) = time_tail.last() else {
+        let first = r.runs.iter().find_map(|x| x.result.clone().err());
+        return Err(AccuracyError::NothingRan {
+            step: h0,
+            first: first.unwrap_or_else(|| "the budget ran out".into()),
+        }
+        .into());
+    };
+    let peaks = peaks(r.values(finest).unwrap_or(&Vec::new()));
+    let Some(Estimate {
+        ladder: time,
+        limit: time_limit,
+        shares: time_shares,
+    }) = estimate(&r, &time_runs, &peaks, TIME_ORDER)
+    else {
+        unreachable!("the time ladder has a successful run")
+    };
+    if time.is_none() {
+        r.notes.push(
+            "one run of the time ladder succeeded: its time error is not estimated (0)".into(),
+        );
+    }
+
+    // the mesh ladder, at the coarsest step whose time share is within a quarter of the
+    // target (the mesh runs are then settings the choice can take), else the finest; past
+    // `opts.mesh_levels` it goes on while no mesh's share is within half the target
+    let has_mesh = base.beams.iter().any(refinable);
+    let tail_levels: Vec<usize> = (0..time_runs.len())
+        .filter(|&k| time_runs[k].is_some_and(|i| time_tail.contains(&i)))
+        .collect();
+    let mesh_level = tail_levels
+        .iter()
+        .copied()
+        .find(|&k| time_shares[k].is_some_and(|s| s <= opts.target / 4.0))
+        .unwrap_or(tail_levels[tail_levels.len() - 1]);
+    let mut mesh_runs: Vec<Option<usize>> = vec![time_runs[mesh_level]];
+    if has_mesh {
+        let mut cost = time_runs[mesh_level].map_or(0.0, |i| r.runs[i].seconds);
+        for j in 1..MAX_MESH_LEVELS {
+            if j >= opts.mesh_levels
+                && (mesh_runs.last() == Some(&None)
+                    || ladder_meets(&r, &mesh_runs, MESH_ORDER, opts.target / 2.0))
+            {
+                break;
+            }
+            let i = r.run(Role::Mesh, at(mesh_level, j as u32), 2.5 * cost);
+            if let Some(i) = i {
+                cost = r.runs[i].seconds;
+            }
+            mesh_runs.push(i);
+        }
+    } else if opts.mesh_levels > 1 {
+        r.notes
+            .push("the scene has no flexible beam to refine: no mesh ladder".into());
+    }
+    let mesh_estimate = estimate(&r, &mesh_runs, &peaks, MESH_ORDER);
+    let mesh = mesh_estimate.as_ref().and_then(|e| e.ladder.clone());
+    // the limit: the mesh ladder's, moved by the time ladder's correction at its step
+    let base_at_mesh_step = time_runs[mesh_level].and_then(|i| r.values(i)).cloned();
+    let (limit, mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
+        (Some(m), Some(e), Some(b)) => (shifted(&m.limit, &time_limit, b), e.shares.clone()),
+        _ => (time_limit.clone(), vec![Some(0.0)]),
+    };
+    if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
+        r.notes.push(
+            "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
+        );
+    }
+    if !has_mesh || opts.mesh_levels == 1 {
+        r.notes
+            .push("the discretization error is not estimated: one mesh only".into());
+    }
+
+    // the choice: the cheapest (step, mesh) whose predicted error meets the target
+    let cost_of = |k: usize, j: usize, r: &Runner| -> Option<f64> {
+        let c = r.runs[time_runs[k]?].seconds;
+        let m0 = r.runs[mesh_runs[0]?].seconds;
+        let mj = r.runs[(*mesh_runs.get(j)?)?].seconds;
+        Some(c * mj / m0.max(1e-9))
+    };
+    // a candidate's error, as a function of time: its time error (at the scene's mesh) plus
+    // its mesh error (at the mesh ladder's step), each weighted; the two may cancel
+    let mesh_limit = mesh_estimate.as_ref().map(|e| e.limit.clone());
+    let error_of = |k: usize, j: usize, wt: f64, wx: f64, r: &Runner| -> Option<Series> {
+        let y = r.values(time_runs[k]?)?;
+        let mut e: Series = y
+            .iter()
+            .zip(&time_limit)
+            .map(|(a, b)| a.iter().zip(b).map(|(u, v)| wt * (u - v)).collect())
+            .collect();
+        if let Some(ml) = &mesh_limit {
+            let z = r.values((*mesh_runs.get(j)?)?)?;
+            for ((o, zo), lo) in e.iter_mut().zip(z).zip(ml) {
+                for ((x, u), v) in o.iter_mut().zip(zo).zip(lo) {
+                    *x += wx * (u - v);
+                }
+            }
+        }
+        Some(e)
+    };
+    // Roache's safety factors of the grid convergence index: 1.25 where every ladder's
+    // order is observed, 3 where one is assumed
+    let observed = |l: &Option<Ladder>| {
+        l.as_ref()
+            .is_some_and(|l| l.source == estimate::OrderSource::Observed)
+    };
+    let margin = if observed(&time) && (observed(&mesh) || !has_mesh || opts.mesh_levels == 1) {
+        SAFETY_OBSERVED
+    } else {
+        SAFETY_ASSUMED
+    };
+    let zero: Series = time_limit.iter().map(|o| vec![0.0; o.len()]).collect();
+    let mut best: Option<(usize, usize, f64, f64)> = None;
+    for (k, ts) in time_shares.iter().enumerate() {
+        for (j, ms) in mesh_shares.iter().enumerate() {
+            if ts.is_none() || ms.is_none() {
+                continue;
+            }
+            let Some(c) = cost_of(k, j, &r) else { continue };
+            let Some(e) = error_of(k, j, 1.0, 1.0, &r) else {
+                continue;
+            };
+            let predicted = distance(&e, &zero, &peaks);
+            if predicted * margin <= opts.target && best.is_none_or(|b| c < b.3) {
+                best = Some((k, j, predicted, c));
+            }
+        }
+    }
+    let mut choice = None;
+    if let Some((k, j, predicted, predicted_seconds)) = best {
+        let setting = at(k, j as u32);
+        let existing = r
+            .runs
+            .iter()
+            .position(|x| x.setting == setting && x.result.is_ok());
+        let run = existing.or_else(|| r.run(Role::Chosen, setting, predicted_seconds));
+        if let Some(run) = run.filter(|&i| r.values(i).is_some()) {
+            let finer_setting = at(k + 1, j as u32 + u32::from(has_mesh));
+            let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
+            // a ladder's run at that setting serves (C4: the mesh ladder ran at the step above)
+            let finer = r
+                .runs
+                .iter()
+                .position(|x| x.setting == finer_setting && x.result.is_ok())
+                .or_else(|| r.run(Role::Finer, finer_setting, finer_cost))
+                .and_then(|i| Some((i, r.values(i)?)))
+                .map(|(i, y)| {
+                    (
+                        i,
+                        distance(y, &r.runs[run].result.clone().unwrap_or_default(), &peaks),
+                    )
+                });
+            let probe = |r: &mut Runner, role, s: Setting| -> Option<Result<f64, String>> {
+                let i = r.run(role, s, predicted_seconds * 1.5)?;
+                let chosen = r.values(run)?;
+                Some(match &r.runs[i].result {
+                    Ok(y) => Ok(distance(y, chosen, &peaks)),
+                    Err(e) => Err(e.clone()),
+                })
+            };
+            let newton_share = probe(
+                &mut r,
+                Role::Newton,
+                Setting {
+                    newton: (setting.newton / NEWTON_PROBE).max(1e-15),
+                    ..setting
+                },
+            )
+            .and_then(Result::ok);
+            let stiffening_change = if has_mesh {
+                probe(
+                    &mut r,
+                    Role::Stiffening,
+                    Setting {
+                        stiffening_switched: true,
+                        ..setting
+                    },
+                )
+            } else {
+                None
+            };
+            // the finer run has each error divided by 2^order: the difference to expect
+            let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
+            let expected_difference = error_of(
+                k,
+                j,
+                1.0 - 0.5f64.powf(order(&time, TIME_ORDER)),
+                if has_mesh {
+                    1.0 - 0.5f64.powf(order(&mesh, MESH_ORDER))
+                } else {
+                    0.0
+                },
+                &r,
+            )
+            .map_or(f64::NAN, |e| distance(&e, &zero, &peaks));
+            choice = Some(Choice {
+                setting,
+                predicted,
+                expected_difference,
+                time_share: time_shares[k].unwrap_or(0.0),
+                mesh_share: mesh_shares[j].unwrap_or(0.0),
+                predicted_seconds,
+                run,
+                finer,
+                newton_share,
+                stiffening_change,
+            });
+        }
+    }
+    r.bar.finish_and_clear();
+
+    // every run's estimated error against the limit
+    for run in &mut r.runs {
+        if let Ok(y) = &run.result {
+            run.errors = distances(y, &limit, &peaks);
+        }
+    }
+    let cpu_seconds = r.runs.iter().map(|x| x.seconds).sum();
+    let mut study = Study {
+        scene: base.name.clone(),
+        outputs: opts.outputs.clone(),
+        target: opts.target,
+        start,
+        stop: start + n as f64 * comm,
+        comm,
+        meshes: (0..=MAX_MESH_LEVELS as u32)
+            .map(|j| mesh_text(&base, j))
+            .collect(),
+        runs: r.runs,
+        time,
+        mesh,
+        mesh_step_level: mesh_level,
+        margin,
+        time_shares,
+        mesh_shares,
+        choice,
+        notes: r.notes,
+        cpu_seconds,
+        wall_seconds: r.started.elapsed().as_secs_f64(),
+    };
+    if let Some(reference) = &reference {
+        truth::judge(&mut study, reference);
+    }
+    Ok(study)
+}

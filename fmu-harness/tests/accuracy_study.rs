@@ -1,0 +1,373 @@
+//! The accuracy study (`fmu-harness accuracy`) against a known exact answer: a clamped beam
+//! with stiffness-proportional damping released from a tip force's static shape, whose tip
+//! deflection is the damped modal series of the continuous Euler–Bernoulli beam. The study's
+//! estimated errors come from its runs alone; here each is compared with the true one.
+
+use fmu_harness::accuracy::{self, Options};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+const L: f64 = 2.0;
+const E: f64 = 72e9;
+const RHO: f64 = 2700.0;
+const SIDE: f64 = 0.01;
+const DELTA: f64 = 0.01;
+
+fn scene_text(beta: f64) -> String {
+    format!(
+        "name = \"damped_cantilever\"\n\
+         [experiment]\nstop_time = 0.5\nstep_size = 1e-3\n\
+         [solver]\nadaptive = false\nmax_step = 1e-3\ntolerance = 1e-8\nrho_inf = 0.9\n\
+         [[beam]]\nname = \"beam\"\nlength = {L}\nelements = 4\nframe = \"tangent\"\n\
+         material = {{ rho = {RHO}, E = {E} }}\n\
+         section = {{ shape = \"rectangle\", a = {SIDE}, b = {SIDE} }}\n\
+         rayleigh = {{ beta = {beta} }}\n\
+         initial = {{ tip_displacement = {DELTA} }}\n\
+         [[joint]]\nname = \"clamp\"\ntype = \"weld\"\nframes = [\"world\", \"beam.a\"]\n"
+    )
+}
+
+fn write_scene(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fmu-accuracy-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Roots βₙL of cos x cosh x = −1.
+fn roots(count: usize) -> Vec<f64> {
+    (1..=count)
+        .map(|n| {
+            let mut x = if n == 1 {
+                1.875
+            } else {
+                (2 * n - 1) as f64 * PI / 2.0
+            };
+            for _ in 0..50 {
+                let sech = 1.0 / x.cosh();
+                let dx = (x.cos() + sech) / (-x.sin() - sech * x.tanh());
+                x -= dx;
+                if dx.abs() < 1e-15 * x {
+                    break;
+                }
+            }
+            x
+        })
+        .collect()
+}
+
+/// A mode of frequency ω and damping ratio ζ released at rest from amplitude 1.
+fn free_decay(w: f64, z: f64, t: f64) -> f64 {
+    if z < 1.0 {
+        let wd = w * (1.0 - z * z).sqrt();
+        (-z * w * t).exp() * ((wd * t).cos() + z * w / wd * (wd * t).sin())
+    } else if z > 1.0 {
+        let r = w * (z * z - 1.0).sqrt();
+        let (s1, s2) = (-z * w + r, -z * w - r);
+        (s2 * (s1 * t).exp() - s1 * (s2 * t).exp()) / (s2 - s1)
+    } else {
+        (1.0 + w * t) * (-w * t).exp()
+    }
+}
+
+/// The exact tip deflection: Σ δ 12/(βₙL)⁴ × the mode's free decay, ζₙ = β ωₙ / 2.
+fn exact_tip(beta: f64, times: &[f64]) -> Vec<f64> {
+    let (a, j) = (SIDE * SIDE, SIDE.powi(4) / 12.0);
+    let c = (E * j / (RHO * a * L.powi(4))).sqrt();
+    let modes: Vec<(f64, f64)> = roots(600)
+        .into_iter()
+        .map(|x| (12.0 / x.powi(4), x * x * c))
+        .collect();
+    times
+        .iter()
+        .map(|&t| {
+            DELTA
+                * modes
+                    .iter()
+                    .rev()
+                    .map(|&(p, w)| p * free_decay(w, beta * w / 2.0, t))
+                    .sum::<f64>()
+        })
+        .collect()
+}
+
+const TIMES: usize = 500;
+const BETA: f64 = 2e-3;
+
+/// The study of the damped cantilever at `target`, from a coarsest step of 4 ms, and the true
+/// error of each run (the study's norm against the exact series).
+fn study(name: &str, target: f64) -> (accuracy::Study, Vec<Option<f64>>) {
+    let path = write_scene(name, &scene_text(BETA));
+    let mut o = Options::new(vec!["beam.tip.deflection".into()], target);
+    o.step = Some(4e-3);
+    let s = accuracy::study(&path, &o).unwrap();
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    let times: Vec<f64> = (0..=TIMES).map(|k| k as f64 * 1e-3).collect();
+    let exact = exact_tip(BETA, &times);
+    let peak = exact.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let truth = s
+        .runs
+        .iter()
+        .map(|r| {
+            let y = &r.result.as_ref().ok()?[0];
+            assert_eq!(y.len(), TIMES + 1);
+            Some(
+                y.iter()
+                    .zip(&exact)
+                    .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()))
+                    / peak,
+            )
+        })
+        .collect();
+    (s, truth)
+}
+
+#[test]
+fn the_exact_series_starts_at_the_static_tip_deflection() {
+    // Σ 12/(βₙL)⁴ = 1: the series holds the whole initial shape at the tip (600 modes: the
+    // tail is below 1e-9 of δ)
+    let y = exact_tip(BETA, &[0.0]);
+    assert!((y[0] / DELTA - 1.0).abs() < 1e-8, "{}", y[0]);
+}
+
+#[test]
+fn estimated_errors_are_within_3x_of_the_true_errors() {
+    let (s, truth) = study("within3", 1e-4);
+    let mut compared = 0;
+    for (r, t) in s.runs.iter().zip(&truth) {
+        if r.setting.stiffening_switched {
+            continue;
+        }
+        let (Some(est), Some(t)) = (r.error(), *t) else {
+            continue;
+        };
+        // measured: 0.72–1.00 (the finest meshes' estimates are the lowest)
+        let ratio = est / t;
+        assert!(
+            (1.0 / 3.0..=3.0).contains(&ratio),
+            "{:?} h = {:e} mesh {}: estimated {est:.3e}, true {t:.3e}",
+            r.role,
+            r.setting.step,
+            r.setting.mesh
+        );
+        compared += 1;
+    }
+    assert!(compared >= 9, "{compared} runs compared");
+}
+
+#[test]
+fn the_observed_order_in_time_is_generalized_alphas_second_order() {
+    let (s, _) = study("order", 1e-4);
+    let time = s.time.as_ref().unwrap();
+    assert_eq!(time.source, accuracy::estimate::OrderSource::Observed);
+    // measured 1.93 (differences 1.24e-3, 3.05e-4, 7.59e-5, 2.00e-5)
+    assert!((time.order - 2.0).abs() < 0.2, "order {}", time.order);
+    // the cubic Hermite mesh converges faster than the step: measured 3.91
+    let mesh = s.mesh.as_ref().unwrap();
+    assert!(mesh.order > 3.0, "mesh order {}", mesh.order);
+}
+
+#[test]
+fn the_chosen_settings_meet_the_target_against_the_exact_answer() {
+    for target in [1e-3, 1e-4] {
+        let (s, truth) = study(&format!("meets{target:e}"), target);
+        let c = s.choice.as_ref().expect("a choice");
+        let t = truth[c.run].unwrap();
+        // measured: 1e-3: 2 ms, 4 elements, true 3.7e-4; 1e-4: 0.5 ms, 8 elements, 3.5e-5
+        assert!(t <= target, "target {target:e}: true error {t:.3e}");
+        // the prediction made before the run is within 3x of the truth
+        assert!(
+            (1.0 / 3.0..=3.0).contains(&(c.predicted / t)),
+            "predicted {:.3e}, true {t:.3e}",
+            c.predicted
+        );
+        // and checked against a finer run: the difference the estimate expects
+        let (_, d) = c.finer.expect("a finer run");
+        let ratio = d / c.expected_difference;
+        assert!((1.0 / 3.0..=3.0).contains(&ratio), "finer check {ratio}");
+        println!(
+            "target {target:e}: h = {:e}, mesh {}, predicted {:.2e}, true {t:.2e}, finer {ratio:.2}",
+            c.setting.step, c.setting.mesh, c.predicted
+        );
+    }
+}
+
+/// The exact tip deflection as a reference CSV beside the scene.
+fn write_reference(scene: &std::path::Path) -> PathBuf {
+    let times: Vec<f64> = (0..=TIMES).map(|k| k as f64 * 1e-3).collect();
+    let mut text = String::from("t,tip\n");
+    for (t, y) in times.iter().zip(exact_tip(BETA, &times)) {
+        text.push_str(&format!("{t:e},{y:e}\n"));
+    }
+    let p = scene.with_file_name("exact.csv");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn harness(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn the_command_writes_the_table_the_csv_and_the_chart() {
+    let path = write_scene("cli", &scene_text(BETA));
+    let dir = path.parent().unwrap().join("out");
+    let reference = write_reference(&path);
+    let out = harness(&[
+        "accuracy",
+        path.to_str().unwrap(),
+        "--output",
+        "beam.tip.deflection",
+        "--target",
+        "1e-4",
+        "--step",
+        "4e-3",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "--column",
+        "tip",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for part in [
+        "| run | ladder | step (s) |",
+        "observed order 1.9",
+        "## Cheapest settings for 1e-4",
+        "consistent: the estimate holds within 3×",
+        "## What limits the error",
+        "Against the reference: true error ",
+        "the target is met",
+        "## Cost",
+    ] {
+        assert!(stdout.contains(part), "no `{part}` in:\n{stdout}");
+    }
+    let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert!(rows[0].starts_with("run,role,step_s,newton_tolerance,mesh,"));
+    assert!(rows[0].ends_with(",estimated_error,error_beam.tip.deflection,true_error"));
+    // 5 steps, 2 more meshes, the chosen setting (unless a ladder ran it), the finer check,
+    // Newton and stiffening (which setting is chosen rests on the runs' measured cost)
+    assert!((1 + 9..=1 + 11).contains(&rows.len()), "{csv}");
+    let first: Vec<&str> = rows[1].split(',').collect();
+    assert_eq!(&first[..4], ["1", "time", "4e-3", "1e-8"]);
+    let est: f64 = first[9].parse().unwrap();
+    assert!((est - 1.43e-3).abs() < 0.05e-3, "{est}");
+    // the exact series, written to 6 digits: the true error of the 4 ms step, 1.425e-3
+    let truth: f64 = first[11].parse().unwrap();
+    assert!((truth - 1.425e-3).abs() < 0.01e-3, "{truth}");
+    let png = std::fs::read(dir.join("accuracy.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(&png[16..24], [0, 0, 2, 208, 0, 0, 1, 224], "720 × 480");
+    assert!(png.len() > 5_000, "{} bytes: an empty chart?", png.len());
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}
+
+#[test]
+fn bad_arguments_are_refused_with_clear_messages() {
+    let path = write_scene("bad", &scene_text(BETA));
+    let scene = path.to_str().unwrap();
+    let reference = write_reference(&path);
+    let reference = reference.to_str().unwrap();
+    for (args, message) in [
+        (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--reference",
+                reference,
+                "--column",
+                "nope",
+            ],
+            "exact.csv: no column nope (it has: t, tip)",
+        ),
+        (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--reference",
+                "/dev/zero",
+                "--column",
+                "tip",
+            ],
+            "--reference /dev/zero: ",
+        ),
+        (
+            vec!["--output", "beam.nope", "--target", "1e-4"],
+            "--output beam.nope: the scene's unit has no real variable of that name (it has: ",
+        ),
+        (
+            vec!["--output", "beam.tip.deflection", "--target", "0"],
+            "--target 0: the error target must be above 0 and below 1",
+        ),
+        (
+            vec!["--output", "beam.tip.deflection", "--target", "-1e-3"],
+            "--target -0.001: the error target must be above 0 and below 1",
+        ),
+        (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--levels",
+                "1",
+            ],
+            "--levels 1: the time ladder needs 2 to 12 steps",
+        ),
+        (
+            vec![
+                "--output",
+                "beam.tip.deflection",
+                "--target",
+                "1e-4",
+                "--step",
+                "-1",
+            ],
+            "--step -1: must be a positive number",
+        ),
+    ] {
+        let mut a = vec!["accuracy", scene];
+        a.extend(args);
+        let out = harness(&a);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{a:?}: {stderr}");
+        assert!(stderr.contains(message), "{a:?}: {stderr}");
+    }
+    // the output name is required
+    let out = harness(&["accuracy", scene, "--target", "1e-4"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--output"));
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}
+
+#[test]
+fn the_study_keeps_to_its_budget_of_runs_and_says_what_it_left_out() {
+    let path = write_scene("budget", &scene_text(BETA));
+    let mut o = Options::new(vec!["beam.tip.deflection".into()], 1e-4);
+    o.step = Some(4e-3);
+    o.max_runs = 3;
+    let s = accuracy::study(&path, &o).unwrap();
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    assert_eq!(s.runs.len(), 3);
+    // 3 steps of the time ladder: 4 and 2 ms do not meet 1e-4 with the mesh's 2e-4 (the mesh
+    // ladder did not run: its error is not estimated), and the rest is named as not run
+    let left_out = s.notes.iter().filter(|n| n.starts_with("not run")).count();
+    assert!(left_out >= 4, "{:#?}", s.notes);
+    assert!(s.notes.iter().any(|n| n.contains("budget 3 runs")));
+    let text = accuracy::report::markdown(&s);
+    assert!(text.contains("3 runs, "), "{text}");
+}
