@@ -58,7 +58,9 @@ pub struct Modes {
     pub non_oscillating: usize,
     /// The joints held fixed (named, or all with `lock_all`), in scene order.
     pub locked: Vec<String>,
-    /// The hub joint at speed (driven at Ω), if spinning.
+    /// The joints the scene itself holds with a motion drive (the hub's included).
+    pub driven: Vec<String>,
+    /// The hub joint (driven at Ω) when spinning or named.
     pub hub: Option<String>,
     /// Hub speed (rad/s).
     pub speed: f64,
@@ -84,12 +86,16 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         )));
     }
     let spinning = options.speed != 0.0;
-    let hub = spinning.then(|| hub_joint(scene, options)).transpose()?;
+    // the hub is held at every speed, 0 included, so that a Campbell diagram's columns agree
+    let hub = (spinning || options.hub.is_some())
+        .then(|| hub_joint(scene, options))
+        .transpose()?;
     let mut to_lock = lock_list(scene, options)?;
     if let Some(h) = &hub {
         to_lock.retain(|n| n != h);
     }
-    let locked_scene = lock(scene, &to_lock, hub.as_deref())?;
+    let given = scene;
+    let locked_scene = lock(given, &to_lock, hub.as_deref())?;
     // the undeformed placement (as before: an initial tip displacement is a start, not a load)
     let mut scene = locked_scene;
     for b in &mut scene.beams {
@@ -119,6 +125,16 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         rigid_body_modes: solved.rigid,
         non_oscillating: solved.non_oscillating,
         locked: to_lock,
+        driven: given
+            .joints
+            .iter()
+            .filter(|j| {
+                j.drive
+                    .as_ref()
+                    .is_some_and(|d| d.kind == DriveKind::Motion)
+            })
+            .map(|j| j.name.clone())
+            .collect(),
         hub,
         speed: options.speed,
     })
