@@ -241,3 +241,65 @@ fn lag_hinge_at_speed_has_the_rigid_blade_frequency() {
         assert!(m.frequencies[0] < rigid && rel(m.frequencies[0], rigid) < 2e-4);
     }
 }
+
+/// The same cantilever as a 3D scene on the spatial element (`formulation = "spatial"`), cut into
+/// s substructures of one element each. The 3D element has no geometric stiffening yet, so the
+/// flap stiffening comes only from the substructures' frames turning against each other,
+/// converging as 1/s² (measured K = 1.0650, 1.1618, 1.1855 for s = 4, 8, 16; 1.1934 by
+/// Richardson). The lead-lag mode is the flap mode less Ω²: ω_flap² − ω_lag² = Ω² (the in-plane
+/// centrifugal softening of the frame), measured within 1e-4 of Ω².
+#[test]
+fn rotating_cantilever_3d_flap_follows_southwell_with_substructures() {
+    let speeds = [2.0, 4.0, 6.0, 8.0];
+    let mut ks = Vec::new();
+    for s in [4, 8, 16] {
+        let text = format!(
+            "name = \"f3\"\ndimensions = 3\nformulation = \"spatial\"\n[[beam]]\nname = \"beam\"\n\
+             length = {L}\nsubstructures = {s}\nelements_per_substructure = 1\n\
+             material = {{ rho = {RHO}, E = {E}, G = 27e9 }}\n\
+             section = {{ shape = \"rectangle\", a = {SIDE}, b = {SIDE} }}\n{HUB}"
+        );
+        let scene = Scene::from_toml_str(&text, "f3.toml").expect("valid scene");
+        let at = |w: f64| {
+            modes(
+                &scene,
+                &ModeOptions {
+                    speed: w,
+                    ..ModeOptions::default()
+                },
+            )
+            .unwrap()
+            .frequencies
+        };
+        let f0 = at(0.0);
+        assert!(
+            rel(f0[1], f0[0]) < 1e-8,
+            "square section: flap = lag at rest"
+        );
+        let w0 = TAU * f0[0];
+        let (mut s11, mut s12, mut s22, mut t1, mut t2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for &w in &speeds {
+            let f = at(w);
+            let (lag, flap) = (TAU * f[0], TAU * f[1]);
+            let gap = (flap * flap - lag * lag) / (w * w) - 1.0;
+            assert!(
+                gap.abs() < 1e-3,
+                "s = {s}, Ω = {w}: flap² − lag² = Ω² (1 + {gap:e})"
+            );
+            let (x, y) = (w * w, flap * flap - w0 * w0);
+            s11 += x * x;
+            s12 += x * x * x;
+            s22 += x * x * x * x;
+            t1 += x * y;
+            t2 += x * x * y;
+        }
+        let k = (t1 * s22 - t2 * s12) / (s11 * s22 - s12 * s12);
+        println!("3D, {s} substructures: flap K = {k:.5}");
+        ks.push(k);
+    }
+    let (d1, d2) = (ks[1] - ks[0], ks[2] - ks[1]);
+    let extrapolated = ks[2] + d2 / 3.0;
+    println!("3D flap K by Richardson from s = 8, 16: {extrapolated:.5}");
+    assert!(d1 / d2 > 3.0 && d1 / d2 < 5.0, "1/s² convergence: {ks:?}");
+    assert!(rel(extrapolated, SOUTHWELL_K1) < 1e-3, "K = {extrapolated}");
+}

@@ -57,7 +57,7 @@ pub enum Command {
         #[arg(long)]
         lock_all: bool,
         /// Hub speed (rad/s): linearize about the steady state spinning at it, in the
-        /// co-rotating frame (planar motion; no gravity or loads in the plane).
+        /// co-rotating frame (a hub about world z; no gravity or loads).
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         speed: f64,
         /// The hub: a revolute joint to `world`, driven at the speed [default: the one such

@@ -4,8 +4,8 @@
 //!
 //! At rest the state is the scene's undeformed placement (its multipliers from the consistent
 //! start, so a hanging pendulum feels gravity). At speed Ω the steady state is solved in the
-//! co-rotating frame (`linearize::steady_state`), and the planar system's invariance to turning
-//! makes the perturbation equations constant in that frame (`linearize::corotating`): the
+//! co-rotating frame (`linearize::steady_state`), and the systems' invariance to turning about
+//! world z makes the perturbation equations constant in that frame (`linearize::corotating`): the
 //! gyroscopic matrix 2ΩMJ and the centrifugal terms come out of the system's own residual.
 //! Motions without any stiffness (rigid-body modes) are counted and taken out exactly
 //! (`eigen::solve`), never reported as a tiny frequency.
@@ -146,30 +146,31 @@ fn linear_model(scene: &Scene, speed: f64) -> Result<linearize::Linear, EngineEr
     let effects = crate::unit::effects::resolve(scene).effects;
     let sys = Mechanics::build(scene, &effects);
     let st = initial_state(&sys, 0.0, &settings)?;
+    let spin = linearize::Spin::of(&sys);
     if speed == 0.0 {
-        return linearize::corotating(&sys, &st.q, &st.lambda, 0.0);
+        return linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0);
     }
-    let Mechanics::Planar(planar) = &sys else {
-        return Err(modes_error(
-            "at speed only planar systems (and 3D scenes whose motion is planar) are \
-             linearized so far; the spatial system has no co-rotating form yet"
-                .into(),
-        ));
+    let (gravity, loads) = match &sys {
+        Mechanics::Planar(s) => (
+            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            s.loads
+                .iter()
+                .any(|l| l.force.norm() > 0.0 || l.torque != 0.0 || l.inputs.is_some()),
+        ),
+        Mechanics::Spatial(s, _) => (
+            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            !s.loads.is_empty(),
+        ),
     };
-    let gravity = planar.gravity.is_some_and(|g| g.norm() > 0.0);
-    let loads = planar
-        .loads
-        .iter()
-        .any(|l| l.force.norm() > 0.0 || l.torque != 0.0 || l.inputs.is_some());
     if gravity || loads {
         return Err(modes_error(
-            "gravity or a load in the plane of rotation makes the spinning state periodic, \
-             not steady: set them to zero to linearize at speed"
+            "gravity or a load makes the spinning state periodic, not steady: set them to \
+             zero to linearize at speed"
                 .into(),
         ));
     }
-    let (q, lambda) = linearize::steady_state(&sys, &st.q, &st.lambda, speed)?;
-    linearize::corotating(&sys, &q, &lambda, speed)
+    let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, speed)?;
+    linearize::corotating(&sys, &spin, &q, &lambda, speed)
 }
 
 /// The hub joint at speed: the one named, else the one revolute joint to `world` with a motion
@@ -189,7 +190,7 @@ fn hub_joint(scene: &Scene, options: &ModeOptions) -> Result<String, EngineError
                 "hub '{name}' must be a revolute joint to `world`"
             )));
         }
-        return Ok(name.clone());
+        return about_z(j);
     }
     let driven: Vec<_> = scene
         .joints
@@ -202,7 +203,7 @@ fn hub_joint(scene: &Scene, options: &ModeOptions) -> Result<String, EngineError
         })
         .collect();
     match driven.as_slice() {
-        [j] => Ok(j.name.clone()),
+        [j] => about_z(j),
         [] => Err(modes_error(
             "no revolute joint to `world` with a motion drive to spin: name the hub".into(),
         )),
@@ -210,6 +211,19 @@ fn hub_joint(scene: &Scene, options: &ModeOptions) -> Result<String, EngineError
             "{} driven revolute joints to `world`: name the hub",
             driven.len()
         ))),
+    }
+}
+
+/// The hub's name, if it turns about the world z axis (the co-rotating frame's axis).
+fn about_z(j: &crate::scene::JointSpec) -> Result<String, EngineError> {
+    match j.axis {
+        Some(a) if a[0].abs() > 1e-12 || a[1].abs() > 1e-12 || a[2] <= 0.0 => {
+            Err(modes_error(format!(
+                "hub '{}' turns about {a:?}: at speed the hub's axis must be world z",
+                j.name
+            )))
+        }
+        _ => Ok(j.name.clone()),
     }
 }
 

@@ -8,14 +8,17 @@
 //! hub. Along a free motion a rigid motion deforms nothing, so its difference is exact up to
 //! the loads' rounding: rigid-body modes keep their zero (see `eigen`).
 //!
-//! The planar system is invariant to turning ([`Turning`]): with q*(t) the steady state turned
-//! by Ωt and δq = T(Ωt) x (T turns each body's position pair, J = dT/d(Ωt) at 0),
+//! The systems are invariant to turning about the world z axis (the planar one as its
+//! `Turning` says; the spatial one with positions turned and quaternions multiplied on the
+//! left, an orthogonal map): with q*(t) the steady state turned by Ωt and δq = T(Ωt) x
+//! (T the turn, [`Spin`], J = dT/d(Ωt) at 0),
 //! δq' = T(x' + ΩJx), δq'' = T(x'' + 2ΩJx' + Ω²J²x), so in the co-rotating frame
 //! M̃ = M, C̃ = C + 2ΩMJ, K̃ = K + ΩCJ + Ω²MJ², constant in time (Coriolis and centrifugal terms;
 //! the stiffening is in K through the deformed state's multipliers and axial strain).
 
 use crate::error::EngineError;
-use crate::mechanics::multibody::equations::{Equations, Turning};
+use crate::mechanics::multibody::equations::Equations;
+use crate::mechanics::Mechanics;
 use nalgebra::{DMatrix, DVector};
 
 /// The linearization on the free motions: reduced M, C, K (r × r) and the elastic mask of the
@@ -33,37 +36,64 @@ pub struct Linear {
     pub rigid: DMatrix<f64>,
 }
 
-/// Which indices of q are the bodies' position pairs and angles (planar), for turning.
-fn pairs_below(turning: Option<Turning>, n: usize) -> Vec<usize> {
-    turning
-        .map(|t| t.pairs.into_iter().filter(|&p| p + 1 < n).collect())
-        .unwrap_or_default()
+/// How the coordinates turn with the whole system about the world z axis: each body's
+/// position pair (x, y), its planar angle (additive), its quaternion (left product with the
+/// turn about z); elastic coordinates, in the body frame, do not turn.
+#[derive(Debug, Clone, Default)]
+pub struct Spin {
+    /// Index in q of each body's position x (y follows).
+    pub pairs: Vec<usize>,
+    /// Index in q of each planar body's angle.
+    pub angles: Vec<usize>,
+    /// Index in q of each spatial body's quaternion e0 (e1, e2, e3 follow).
+    pub quaternions: Vec<usize>,
 }
 
-/// J x: each position pair turned by 90° (zero elsewhere).
-fn turn(pairs: &[usize], x: &DVector<f64>) -> DVector<f64> {
-    let mut out = DVector::zeros(x.len());
-    for &p in pairs {
-        out[p] = -x[p + 1];
-        out[p + 1] = x[p];
+impl Spin {
+    /// The turning coordinates of a planar or spatial system.
+    pub fn of(sys: &Mechanics) -> Spin {
+        match sys {
+            Mechanics::Planar(s) => Spin {
+                pairs: s.offsets.clone(),
+                angles: s.offsets.iter().map(|o| o + 2).collect(),
+                quaternions: Vec::new(),
+            },
+            Mechanics::Spatial(s, _) => Spin {
+                pairs: s.offsets.clone(),
+                angles: Vec::new(),
+                quaternions: s.offsets.iter().map(|o| o + 3).collect(),
+            },
+        }
     }
-    out
-}
 
-/// The steady rates and accelerations at q spinning at Ω about the origin: each body's frame
-/// turns at Ω, its position moves as Ω J p and accelerates as -Ω² p, its deformation is still.
-fn steady_rates(
-    pairs: &[usize],
-    angles: &[usize],
-    q: &DVector<f64>,
-    omega: f64,
-) -> (DVector<f64>, DVector<f64>) {
-    let mut v = turn(pairs, q) * omega;
-    for &a in angles {
-        v[a] = omega;
+    /// J x, the linear part of the turn's generator: (x, y) → (-y, x); a quaternion p →
+    /// ½ (0, e_z) ⊗ p = ½ (-e3, -e2, e1, e0); zero elsewhere.
+    fn turn(&self, x: &DVector<f64>) -> DVector<f64> {
+        let mut out = DVector::zeros(x.len());
+        for &p in &self.pairs {
+            out[p] = -x[p + 1];
+            out[p + 1] = x[p];
+        }
+        for &e in &self.quaternions {
+            out[e] = -0.5 * x[e + 3];
+            out[e + 1] = -0.5 * x[e + 2];
+            out[e + 2] = 0.5 * x[e + 1];
+            out[e + 3] = 0.5 * x[e];
+        }
+        out
     }
-    let a = turn(pairs, &turn(pairs, q)) * (omega * omega);
-    (v, a)
+
+    /// The steady rates and accelerations at q spinning at Ω about the world z axis: q' = ΩJq
+    /// (and Ω for a planar angle), q'' = Ω²J²q; the deformation is still.
+    fn rates(&self, q: &DVector<f64>, omega: f64) -> (DVector<f64>, DVector<f64>) {
+        let jq = self.turn(q);
+        let a = self.turn(&jq) * (omega * omega);
+        let mut v = jq * omega;
+        for &i in &self.angles {
+            v[i] = omega;
+        }
+        (v, a)
+    }
 }
 
 /// r(q, v, a, 0) + G(q)ᵀλ.
@@ -92,17 +122,12 @@ fn step_q<E: Equations>(sys: &E) -> f64 {
 /// g(q, 0) = 0, its q-columns by central differences, in 8 steps of speed from rest.
 pub fn steady_state<E: Equations>(
     sys: &E,
+    spin: &Spin,
     q0: &DVector<f64>,
     lambda0: &DVector<f64>,
     omega: f64,
 ) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
     let (n, m) = (sys.n(), sys.m());
-    let turning = sys.turning();
-    let angles = turning
-        .as_ref()
-        .map(|t| t.angles.clone())
-        .unwrap_or_default();
-    let pairs = pairs_below(turning, n);
     let (mut q, mut lambda) = (q0.clone(), lambda0.clone());
     let h = step_q(sys);
     let scale = sys.length_scale().max(1e-3);
@@ -110,7 +135,7 @@ pub fn steady_state<E: Equations>(
     for s in 1..=STEPS {
         let w = omega * s as f64 / STEPS as f64;
         let f = |q: &DVector<f64>, lambda: &DVector<f64>| {
-            let (v, a) = steady_rates(&pairs, &angles, q, w);
+            let (v, a) = spin.rates(q, w);
             residual(sys, q, &v, &a, lambda)
         };
         let mut converged = false;
@@ -172,23 +197,13 @@ pub fn steady_state<E: Equations>(
 /// `omega`, reduced to the free motions.
 pub fn corotating<E: Equations>(
     sys: &E,
+    spin: &Spin,
     q: &DVector<f64>,
     lambda: &DVector<f64>,
     omega: f64,
 ) -> Result<Linear, EngineError> {
     let n = sys.n();
-    let turning = sys.turning();
-    let angles = turning
-        .as_ref()
-        .map(|t| t.angles.clone())
-        .unwrap_or_default();
-    let pairs = pairs_below(turning, n);
-    if omega != 0.0 && pairs.is_empty() {
-        return Err(EngineError::Modes {
-            message: "this system has no co-rotating form".into(),
-        });
-    }
-    let (v0, a0) = steady_rates(&pairs, &angles, q, omega);
+    let (v0, a0) = spin.rates(q, omega);
     let mut gm = DMatrix::zeros(sys.m(), n);
     sys.constraint_jacobian(q, 0.0, &mut gm);
     let basis = null_space(&gm, n);
@@ -215,10 +230,10 @@ pub fn corotating<E: Equations>(
         let mut c = dv(&d);
         let mut kcol = DVector::zeros(n);
         if omega != 0.0 {
-            let jd = turn(&pairs, &d);
+            let jd = spin.turn(&d);
             // C̃ = C + 2ΩMJ, K̃ = K + ΩCJ + Ω²MJ²
             c += &mm * &jd * (2.0 * omega);
-            kcol += dv(&jd) * omega + &mm * turn(&pairs, &jd) * (omega * omega);
+            kcol += dv(&jd) * omega + &mm * spin.turn(&jd) * (omega * omega);
         }
         cn.set_column(k, &c);
         let kk = kn.column(k) + kcol;
