@@ -25,7 +25,7 @@ def harness_modes(scene: Path, count: int = 5) -> list[float]:
         [str(HARNESS), "modes", str(scene), "--count", str(count)],
         check=True, capture_output=True, text=True,
     ).stdout
-    return [float(x) for x in re.findall(r"mode\s+\d+:\s+([0-9.eE+-]+)\s+Hz", out)]
+    return [float(x) for x in re.findall(r"^mode\s+\d+:\s+([0-9.eE+-]+)\s+Hz", out, re.MULTILINE)]
 
 
 def peak_frequency(signal: np.ndarray, dt: float, near: float) -> float:

@@ -18,6 +18,13 @@ pub enum EngineError {
         /// What is wrong, with the joints or the time concerned.
         message: String,
     },
+    /// The modes cannot be computed as asked: an unknown or unlockable joint, no hub to spin,
+    /// a spinning state that is not steady, or no steady state found.
+    #[error("modes: {message}")]
+    Modes {
+        /// What is wrong, naming the joint or the figure concerned.
+        message: String,
+    },
     #[error(
         "the mechanism cannot be assembled at t = {t} s: constraint residual {residual:.3e} \
          of joint(s) {joints} stays above {tolerance:.1e} after {iterations} iterations"

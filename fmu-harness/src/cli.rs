@@ -41,13 +41,36 @@ pub enum Command {
         /// The scene file (TOML).
         scene: PathBuf,
     },
-    /// Print the scene's linearized natural frequencies in Hz (rigid-body modes left out).
+    /// Print the scene's linearized natural frequencies in Hz, with its joints free or locked,
+    /// at rest or about the steady state spinning at a hub speed (rigid-body modes counted and
+    /// left out); or write its Campbell diagram (frequencies against hub speed) as CSV and PNG.
     Modes {
         /// The scene file (TOML).
         scene: PathBuf,
-        /// How many modes to print.
+        /// How many modes to print (and to draw in a Campbell diagram).
         #[arg(long, default_value_t = 10)]
         count: usize,
+        /// Hold this joint's coordinate where the scene starts it (repeatable).
+        #[arg(long, value_name = "JOINT")]
+        lock: Vec<String>,
+        /// Hold every revolute, prismatic and spherical joint.
+        #[arg(long)]
+        lock_all: bool,
+        /// Hub speed (rad/s): linearize about the steady state spinning at it, in the
+        /// co-rotating frame (a hub about world z; no gravity or loads).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        speed: f64,
+        /// The hub: a revolute joint to `world`, driven at the speed [default: the one such
+        /// joint with a motion drive].
+        #[arg(long, value_name = "JOINT")]
+        hub: Option<String>,
+        /// Campbell diagram over hub speeds `START:STOP:COUNT` (rad/s), e.g. 0:10:21: writes
+        /// PREFIX.csv and PREFIX.png.
+        #[arg(long, value_name = "START:STOP:COUNT")]
+        campbell: Option<String>,
+        /// The Campbell diagram's files, without extension [default: <scene>_campbell].
+        #[arg(short, long, value_name = "PREFIX")]
+        output: Option<PathBuf>,
     },
     /// Write the JSON Schema of scene files (shipped as scenes/scene.schema.json; a scene whose
     /// first line is `#:schema ./scene.schema.json` is completed and checked by Taplo-based
@@ -195,7 +218,27 @@ pub fn run_with_engines(
         Command::Reference { output } => {
             write_text(&reference::scene_reference(), output.as_deref(), out)
         }
-        Command::Modes { scene, count } => modes_cmd(&scene, count, out),
+        Command::Modes {
+            scene,
+            count,
+            lock,
+            lock_all,
+            speed,
+            hub,
+            campbell,
+            output,
+        } => {
+            let options = fmu_beam::ModeOptions {
+                lock,
+                lock_all,
+                speed,
+                hub,
+            };
+            match campbell {
+                Some(spec) => campbell_cmd(&scene, count, options, &spec, output, out),
+                None => modes_cmd(&scene, count, &options, out),
+            }
+        }
         Command::Accuracy(args) => accuracy_cmd(args, out),
     }
 }
@@ -545,10 +588,16 @@ fn explain_cmd(scene: &Path, out: &mut dyn Write) -> Result<(), HarnessError> {
     out.write_all(text.as_bytes()).map_err(stdout_err)
 }
 
-/// `modes`: the first `count` elastic natural frequencies.
-fn modes_cmd(scene: &Path, count: usize, out: &mut dyn Write) -> Result<(), HarnessError> {
-    let f = modes::elastic_frequencies(scene)?;
-    out.write_all(modes::report(&f, count).as_bytes())
+/// `modes`: what was linearized, then the first `count` natural frequencies.
+fn modes_cmd(
+    scene_path: &Path,
+    count: usize,
+    options: &fmu_beam::ModeOptions,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let scene = fmu_beam::Scene::load(scene_path)?;
+    let m = modes::modes_of(&scene, &scene_path.display().to_string(), options)?;
+    out.write_all(modes::full_report(&m, count).as_bytes())
         .map_err(stdout_err)
 }
 
@@ -585,6 +634,63 @@ fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<(), HarnessEr
         png.display()
     )
     .map_err(stdout_err)
+}
+
+/// `modes --campbell`: the first `count` frequencies at each speed, as CSV and PNG.
+fn campbell_cmd(
+    scene_path: &Path,
+    count: usize,
+    options: fmu_beam::ModeOptions,
+    spec: &str,
+    output: Option<PathBuf>,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let speeds = modes::campbell::parse_speeds(spec)?;
+    let scene = fmu_beam::Scene::load(scene_path)?;
+    let origin = scene_path.display().to_string();
+    let mut frequencies = Vec::with_capacity(speeds.len());
+    let mut last = None;
+    for &speed in &speeds {
+        let o = fmu_beam::ModeOptions {
+            speed,
+            ..options.clone()
+        };
+        let m = modes::modes_of(&scene, &origin, &o)?;
+        frequencies.push(m.frequencies.iter().copied().take(count).collect());
+        last = Some(m);
+    }
+    let d = modes::campbell::Diagram {
+        speeds,
+        frequencies,
+    };
+    let prefix = output.unwrap_or_else(|| PathBuf::from(format!("{}_campbell", scene.name)));
+    let with = |ext: &str| {
+        let mut p = prefix.clone().into_os_string();
+        p.push(ext);
+        PathBuf::from(p)
+    };
+    let (csv, png) = (with(".csv"), with(".png"));
+    crate::archive::write_atomically(&csv, d.csv().as_bytes())?;
+    let title = format!("{}: Campbell diagram", scene.name);
+    crate::archive::write_atomically(&png, &d.png(&title, 800, 560))?;
+    let m = last.expect("at least two speeds");
+    let text = format!(
+        "Campbell diagram of {} modes at {} speeds from {} to {} rad/s (hub '{}'; joints \
+         locked: {}): wrote {} and {}\n",
+        d.modes(),
+        d.speeds.len(),
+        d.speeds[0],
+        d.speeds[d.speeds.len() - 1],
+        m.hub.as_deref().unwrap_or("?"),
+        if m.locked.is_empty() {
+            "none".to_string()
+        } else {
+            m.locked.join(", ")
+        },
+        csv.display(),
+        png.display()
+    );
+    out.write_all(text.as_bytes()).map_err(stdout_err)
 }
 
 /// `WIDTHxHEIGHT` in pixels.

@@ -9,6 +9,7 @@
 pub mod accuracy;
 pub mod animate;
 pub mod archive;
+pub mod chart;
 pub mod cli;
 pub mod cosim;
 pub mod engine_library;

@@ -1,13 +1,14 @@
-//! `fmu-harness modes`: the scene's linearized natural frequencies, rigid-body modes left out.
+//! `fmu-harness modes`: the scene's linearized natural frequencies with its joints free or
+//! locked, at rest or at a hub speed, and its Campbell diagram (frequencies against speed) as
+//! CSV and PNG.
+
+pub mod campbell;
 
 use crate::error::HarnessError;
-use fmu_beam::Scene;
+use fmu_beam::{ModeOptions, Modes, Scene};
 use std::path::Path;
 
-/// Frequencies below this (Hz) are rigid-body modes.
-pub const RIGID_BODY_LIMIT_HZ: f64 = 1e-6;
-
-/// The elastic natural frequencies (Hz, ascending) of the scene file.
+/// The elastic natural frequencies (Hz, ascending) of the scene file, joints free, at rest.
 pub fn elastic_frequencies(scene_path: &Path) -> Result<Vec<f64>, HarnessError> {
     let scene = Scene::load(scene_path)?;
     elastic_frequencies_of(&scene, &scene_path.display().to_string())
@@ -16,13 +17,58 @@ pub fn elastic_frequencies(scene_path: &Path) -> Result<Vec<f64>, HarnessError> 
 /// The elastic natural frequencies (Hz, ascending) of a loaded scene; `origin` (its file, or
 /// what the caller names it) prefixes an error.
 pub fn elastic_frequencies_of(scene: &Scene, origin: &str) -> Result<Vec<f64>, HarnessError> {
-    let f = fmu_beam::natural_frequencies(scene).map_err(|source| HarnessError::Engine {
+    Ok(modes_of(scene, origin, &ModeOptions::default())?.frequencies)
+}
+
+/// The modes of a loaded scene linearized as `options` say.
+pub fn modes_of(scene: &Scene, origin: &str, options: &ModeOptions) -> Result<Modes, HarnessError> {
+    fmu_beam::modes(scene, options).map_err(|source| HarnessError::Engine {
         origin: origin.to_string(),
         source,
-    })?;
-    Ok(f.into_iter()
-        .filter(|&f| f >= RIGID_BODY_LIMIT_HZ)
-        .collect())
+    })
+}
+
+/// The report: what was linearized (speed and hub, locked joints, rigid-body modes left
+/// out), then `mode <k>: <f> Hz` lines, k from 1, at most `count` of them, then the damped
+/// modes where the scene has damping.
+pub fn full_report(m: &Modes, count: usize) -> String {
+    let mut s = String::new();
+    match &m.hub {
+        Some(h) if m.speed != 0.0 => {
+            s += &format!(
+            "linearized about the steady state at {} rad/s about hub '{h}' (co-rotating frame, \
+             gyroscopic and centrifugal terms)\n",
+            significant(m.speed, 6)
+        )
+        }
+        Some(h) => s += &format!("linearized at rest, hub '{h}' held\n"),
+        None => s += "linearized at rest about the initial placement\n",
+    }
+    if m.locked.is_empty() {
+        s += "joints locked: none\n";
+    } else {
+        s += &format!("joints locked: {}\n", m.locked.join(", "));
+    }
+    if !m.driven.is_empty() {
+        s += &format!("joints held by a motion drive: {}\n", m.driven.join(", "));
+    }
+    s += &format!("rigid-body modes: {} (left out)\n", m.rigid_body_modes);
+    if m.non_oscillating > 0 {
+        s += &format!(
+            "modes that do not oscillate (diverging or overdamped): {}\n",
+            m.non_oscillating
+        );
+    }
+    s += &report(&m.frequencies, count);
+    for (k, d) in m.damped.iter().take(count).enumerate() {
+        s += &format!(
+            "damped mode {}: {} Hz, damping ratio {}\n",
+            k + 1,
+            significant(d.frequency, 9),
+            significant(d.damping_ratio, 4)
+        );
+    }
+    s
 }
 
 /// `mode <k>: <f> Hz` lines, k from 1, at most `count` of them.

@@ -1,102 +1,307 @@
-//! Linearized natural frequencies about the initial state: the eigenproblem
-//! K φ = ω² M φ on the motions the joints leave free (null space of G).
+//! Linearized natural frequencies: with the scene's joints free or some of them locked, at rest
+//! or spinning at a steady speed about a hub joint (the co-rotating steady state, deformed by
+//! its centrifugal load), as M x'' + C x' + K x = 0 on the motions the joints leave free.
+//!
+//! At rest the state is the scene's undeformed placement (its multipliers from the consistent
+//! start, so a hanging pendulum feels gravity). At speed Ω the steady state is solved in the
+//! co-rotating frame (`linearize::steady_state`), and the systems' invariance to turning about
+//! world z makes the perturbation equations constant in that frame (`linearize::corotating`): the
+//! gyroscopic matrix 2ΩMJ and the centrifugal terms come out of the system's own residual.
+//! Motions without any stiffness (rigid-body modes) are counted and taken out exactly
+//! (`eigen::solve`), never reported as a tiny frequency.
+
+mod eigen;
+mod linearize;
 
 use crate::error::EngineError;
 use crate::integrator::{initial_state, Settings};
-use crate::mechanics::multibody::equations::{Equations, Point};
 use crate::mechanics::Mechanics;
-use crate::scene::Scene;
-use nalgebra::{DMatrix, DVector};
+use crate::scene::{DriveKind, DriveSpec, JointKind, LawSpec, Scene};
+use crate::unit::engine::Engine;
 
-/// Natural frequencies (Hz), ascending, of the scene linearized about its initial
-/// configuration at rest (deformation and loads as at t = 0). A 3D scene is linearized with
-/// the element it runs with (planar when its motion is planar).
-pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
-    let settings = Settings::from_scene(scene);
-    // linearize about the undeformed equilibrium of the free motions
-    let undeformed = Scene {
-        beams: scene
-            .beams
-            .iter()
-            .cloned()
-            .map(|mut b| {
-                b.initial.tip_displacement = 0.0;
-                b
-            })
-            .collect(),
-        ..scene.clone()
-    };
-    let effects = crate::unit::effects::resolve(scene).effects;
-    crate::unit::memory::ensure_available(scene, "natural frequencies")?;
-    let sys = Mechanics::build(scene, &effects);
-    let st = initial_state(&sys, 0.0, &settings)?;
-    let q = Mechanics::build(&undeformed, &effects).initial_coordinates()?;
-    linearized(&sys, &q, &st.lambda)
+/// How to linearize: which joints to lock, and at what hub speed.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ModeOptions {
+    /// Joints (by name) whose coordinate is held where the scene starts it.
+    pub lock: Vec<String>,
+    /// Lock every revolute, prismatic and spherical joint.
+    pub lock_all: bool,
+    /// Hub speed Ω (rad/s): linearize about the steady state spinning at Ω.
+    pub speed: f64,
+    /// The hub joint (a revolute joint to `world`); by default the one revolute joint to
+    /// `world` with a motion drive.
+    pub hub: Option<String>,
 }
 
-/// Frequencies of K φ = ω² M φ at q (at rest) on the null space of G.
-fn linearized<E: Equations>(
-    sys: &E,
-    q: &DVector<f64>,
-    lambda: &DVector<f64>,
-) -> Result<Vec<f64>, EngineError> {
-    let (n, m) = (sys.n(), sys.m());
-    let zero = DVector::zeros(n);
-    let mut mm = DMatrix::zeros(n, n);
-    let mut kt = DMatrix::zeros(n, n);
-    let mut ct = DMatrix::zeros(n, n);
-    let mut gm = DMatrix::zeros(m, n);
-    sys.mass_matrix(q, &mut mm);
-    let at = Point {
-        q,
-        v: &zero,
-        a: &zero,
-        lambda,
-        t: 0.0,
-    };
-    sys.tangents(&at, &mut kt, &mut ct);
-    sys.constraint_jacobian(q, 0.0, &mut gm);
-    let basis = null_space(&gm, n);
-    let mr = basis.transpose() * &mm * &basis;
-    let kr = basis.transpose() * &kt * &basis;
-    let mr = (&mr + mr.transpose()) * 0.5;
-    let kr = (&kr + kr.transpose()) * 0.5;
-    let chol = mr.cholesky().ok_or_else(|| EngineError::InitialState {
-        message: "the mass matrix is not positive definite on the free motions".into(),
-    })?;
-    let linv = chol
-        .l()
-        .try_inverse()
-        .ok_or_else(|| EngineError::InitialState {
-            message: "singular mass matrix on the free motions".into(),
-        })?;
-    let a = &linv * kr * linv.transpose();
-    let a = (&a + a.transpose()) * 0.5;
-    let eig = a.symmetric_eigen();
-    let mut f: Vec<f64> = eig
-        .eigenvalues
-        .iter()
-        .map(|&l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-        .collect();
-    f.sort_by(|a, b| a.total_cmp(b));
+/// One oscillating mode of the damped system.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DampedMode {
+    /// Damped natural frequency |Im s| / 2π (Hz).
+    pub frequency: f64,
+    /// Damping ratio -Re s / |s|.
+    pub damping_ratio: f64,
+}
+
+/// The modes of a linearized scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// Natural frequencies without the scene's damping (Hz, ascending): gyroscopic terms
+    /// kept at speed; rigid-body modes left out.
+    pub frequencies: Vec<f64>,
+    /// With the scene's Rayleigh damping, where a beam has some (else empty): one per
+    /// oscillating mode, by ascending frequency.
+    pub damped: Vec<DampedMode>,
+    /// How many motions have no stiffness at all (rigid-body modes).
+    pub rigid_body_modes: usize,
+    /// Modes that do not oscillate (real eigenvalue pairs: overdamped, or diverging when
+    /// centrifugal softening exceeds the stiffness).
+    pub non_oscillating: usize,
+    /// The joints held fixed (named, or all with `lock_all`), in scene order.
+    pub locked: Vec<String>,
+    /// The joints the scene itself holds with a motion drive (the hub's included).
+    pub driven: Vec<String>,
+    /// The hub joint (driven at Ω) when spinning or named.
+    pub hub: Option<String>,
+    /// Hub speed (rad/s).
+    pub speed: f64,
+}
+
+/// Natural frequencies (Hz), ascending, of the scene linearized about its initial
+/// configuration at rest with its joints free: one 0 for each rigid-body mode, then the
+/// elastic ones. A 3D scene is linearized with the element it runs with (planar when its
+/// motion is planar).
+pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
+    let m = modes(scene, &ModeOptions::default())?;
+    let mut f = vec![0.0; m.rigid_body_modes];
+    f.extend(m.frequencies);
     Ok(f)
 }
 
-/// Orthonormal basis of the null space of G (n × (n - rank)).
-fn null_space(gm: &DMatrix<f64>, n: usize) -> DMatrix<f64> {
-    if gm.nrows() == 0 {
-        return DMatrix::identity(n, n);
+/// The modes of the scene linearized as `options` say.
+pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError> {
+    if !options.speed.is_finite() {
+        return Err(modes_error(format!(
+            "speed {} rad/s is not a finite number",
+            options.speed
+        )));
     }
-    // Complete the row space with the SVD of the square matrix [G; 0].
-    let mut sq = DMatrix::zeros(n, n);
-    sq.view_mut((0, 0), (gm.nrows().min(n), n))
-        .copy_from(&gm.rows(0, gm.nrows().min(n)));
-    let svd = sq.svd(false, true);
-    let vt = svd.v_t.expect("v_t requested");
-    let smax = svd.singular_values.amax().max(1e-300);
-    let cols: Vec<_> = (0..n)
-        .filter(|&k| svd.singular_values[k] <= 1e-10 * smax)
-        .map(|k| vt.row(k).transpose())
+    let spinning = options.speed != 0.0;
+    // the hub is held at every speed, 0 included, so that a Campbell diagram's columns agree
+    let hub = (spinning || options.hub.is_some())
+        .then(|| hub_joint(scene, options))
+        .transpose()?;
+    let mut to_lock = lock_list(scene, options)?;
+    if let Some(h) = &hub {
+        to_lock.retain(|n| n != h);
+    }
+    let given = scene;
+    let locked_scene = lock(given, &to_lock, hub.as_deref())?;
+    // the undeformed placement (as before: an initial tip displacement is a start, not a load)
+    let mut scene = locked_scene;
+    for b in &mut scene.beams {
+        b.initial.tip_displacement = 0.0;
+    }
+    let damped_scene = scene.clone();
+    let has_damping = scene
+        .beams
+        .iter()
+        .any(|b| b.rayleigh.alpha != 0.0 || b.rayleigh.beta != 0.0);
+    for b in &mut scene.beams {
+        b.rayleigh.alpha = 0.0;
+        b.rayleigh.beta = 0.0;
+    }
+    crate::unit::memory::ensure_available(&scene, "natural frequencies")?;
+    let undamped = linear_model(&scene, options.speed)?;
+    let solved = eigen::solve(&undamped, spinning)?;
+    let damped = if has_damping {
+        let lin = linear_model(&damped_scene, options.speed)?;
+        eigen::solve(&lin, true)?.damped
+    } else {
+        Vec::new()
+    };
+    Ok(Modes {
+        frequencies: solved.frequencies,
+        damped,
+        rigid_body_modes: solved.rigid,
+        non_oscillating: solved.non_oscillating,
+        locked: to_lock,
+        driven: given
+            .joints
+            .iter()
+            .filter(|j| {
+                j.drive
+                    .as_ref()
+                    .is_some_and(|d| d.kind == DriveKind::Motion)
+            })
+            .map(|j| j.name.clone())
+            .collect(),
+        hub,
+        speed: options.speed,
+    })
+}
+
+/// The scene's system linearized at rest (its start) or at the steady state at `speed`.
+fn linear_model(scene: &Scene, speed: f64) -> Result<linearize::Linear, EngineError> {
+    let settings = Settings::from_scene(scene);
+    let effects = crate::unit::effects::resolve(scene).effects;
+    let sys = Mechanics::build(scene, &effects);
+    let st = initial_state(&sys, 0.0, &settings)?;
+    let spin = linearize::Spin::of(&sys);
+    if speed == 0.0 {
+        return linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0);
+    }
+    let (gravity, loads) = match &sys {
+        Mechanics::Planar(s) => (
+            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            s.loads
+                .iter()
+                .any(|l| l.force.norm() > 0.0 || l.torque != 0.0 || l.inputs.is_some()),
+        ),
+        Mechanics::Spatial(s, _) => (
+            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            !s.loads.is_empty(),
+        ),
+    };
+    if gravity || loads {
+        return Err(modes_error(
+            "gravity or a load makes the spinning state periodic, not steady: set them to \
+             zero to linearize at speed"
+                .into(),
+        ));
+    }
+    let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, speed)?;
+    linearize::corotating(&sys, &spin, &q, &lambda, speed)
+}
+
+/// The hub joint at speed: the one named, else the one revolute joint to `world` with a motion
+/// drive.
+fn hub_joint(scene: &Scene, options: &ModeOptions) -> Result<String, EngineError> {
+    let to_world = |j: &&crate::scene::JointSpec| {
+        j.kind == JointKind::Revolute && j.frames.iter().any(|f| f == "world")
+    };
+    if let Some(name) = &options.hub {
+        let j = scene
+            .joints
+            .iter()
+            .find(|j| &j.name == name)
+            .ok_or_else(|| modes_error(format!("no joint named '{name}' to spin as the hub")))?;
+        if !to_world(&j) {
+            return Err(modes_error(format!(
+                "hub '{name}' must be a revolute joint to `world`"
+            )));
+        }
+        return about_z(j);
+    }
+    let driven: Vec<_> = scene
+        .joints
+        .iter()
+        .filter(to_world)
+        .filter(|j| {
+            j.drive
+                .as_ref()
+                .is_some_and(|d| d.kind == DriveKind::Motion)
+        })
         .collect();
-    DMatrix::from_columns(&cols)
+    match driven.as_slice() {
+        [j] => about_z(j),
+        [] => Err(modes_error(
+            "no revolute joint to `world` with a motion drive to spin: name the hub".into(),
+        )),
+        _ => Err(modes_error(format!(
+            "{} driven revolute joints to `world`: name the hub",
+            driven.len()
+        ))),
+    }
+}
+
+/// The hub's name, if it turns about the world z axis (the co-rotating frame's axis).
+fn about_z(j: &crate::scene::JointSpec) -> Result<String, EngineError> {
+    match j.axis {
+        Some(a) if a[0].abs() > 1e-12 || a[1].abs() > 1e-12 || a[2] <= 0.0 => {
+            Err(modes_error(format!(
+                "hub '{}' turns about {a:?}: at speed the hub's axis must be world z",
+                j.name
+            )))
+        }
+        _ => Ok(j.name.clone()),
+    }
+}
+
+/// The joints to lock, in scene order: those named (each must exist), or every joint that
+/// moves with `lock_all`.
+fn lock_list(scene: &Scene, options: &ModeOptions) -> Result<Vec<String>, EngineError> {
+    for name in &options.lock {
+        if !scene.joints.iter().any(|j| &j.name == name) {
+            let known: Vec<_> = scene.joints.iter().map(|j| j.name.as_str()).collect();
+            return Err(modes_error(format!(
+                "no joint named '{name}' to lock (joints: {})",
+                known.join(", ")
+            )));
+        }
+    }
+    Ok(scene
+        .joints
+        .iter()
+        .filter(|j| {
+            (options.lock_all && j.kind != JointKind::Weld) || options.lock.contains(&j.name)
+        })
+        .map(|j| j.name.clone())
+        .collect())
+}
+
+/// The scene with the joints `names` and the `hub` held: a revolute or prismatic joint gets a
+/// motion drive holding its coordinate where the scene starts it (read from the unit, so that
+/// a joint's given start is honoured), a spherical joint becomes a weld.
+fn lock(scene: &Scene, names: &[String], hub: Option<&str>) -> Result<Scene, EngineError> {
+    let holds = |j: &crate::scene::JointSpec| {
+        (names.contains(&j.name) || hub == Some(j.name.as_str()))
+            && !j
+                .drive
+                .as_ref()
+                .is_some_and(|d| d.kind == DriveKind::Motion)
+    };
+    if !scene.joints.iter().any(holds) {
+        return Ok(scene.clone());
+    }
+    let mut started = Engine::new(scene.clone());
+    started.exit_initialization()?;
+    let mut out = scene.clone();
+    for j in out.joints.iter_mut().filter(|j| holds(j)) {
+        let output = match j.kind {
+            JointKind::Weld => continue,
+            JointKind::Spherical => {
+                j.kind = JointKind::Weld;
+                j.initial = None;
+                j.drive = None;
+                continue;
+            }
+            JointKind::Revolute => format!("{}.angle", j.name),
+            JointKind::Prismatic => format!("{}.position", j.name),
+        };
+        let vr = started
+            .variables()
+            .by_name(&output)
+            .map(|v| v.vr)
+            .ok_or_else(|| modes_error(format!("joint '{}': no output {output}", j.name)))?;
+        let value = started.get_real(vr)?;
+        j.initial = None;
+        j.drive = Some(DriveSpec {
+            kind: DriveKind::Motion,
+            law: LawSpec {
+                law: "constant".into(),
+                value: Some(value),
+                time_constant: None,
+                until: None,
+                omega: None,
+                ramp_time: None,
+                table: None,
+            },
+        });
+    }
+    out.validate("modes")?;
+    Ok(out)
+}
+
+fn modes_error(message: String) -> EngineError {
+    EngineError::Modes { message }
 }

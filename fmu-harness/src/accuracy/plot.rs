@@ -1,16 +1,15 @@
 //! The study's work-precision chart as a PNG: estimated error against CPU seconds, log-log,
 //! one line per ladder, the target, the chosen setting and its finer check. Drawn with
-//! `embedded-graphics` (as the animations are) into an RGB buffer; the PNG is written here
-//! (signature, IHDR, one zlib IDAT, IEND).
+//! `embedded-graphics` (as the animations are) on the charts' [`Canvas`].
 
 use super::report::on_ladder;
 use super::{Role, Study};
+use crate::chart::Canvas;
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::{Circle, Line, Polyline, PrimitiveStyle, Rectangle};
 use embedded_graphics::text::{Alignment, Text};
-use std::io::Write as _;
 
 const WIDTH: u32 = 720;
 const HEIGHT: u32 = 480;
@@ -24,35 +23,6 @@ const FINER: Rgb888 = Rgb888::new(44, 160, 44);
 const GREY: Rgb888 = Rgb888::new(170, 170, 170);
 const INK: Rgb888 = Rgb888::new(30, 30, 30);
 
-/// An RGB frame.
-struct Canvas {
-    pixels: Vec<u8>,
-}
-
-impl OriginDimensions for Canvas {
-    fn size(&self) -> Size {
-        Size::new(WIDTH, HEIGHT)
-    }
-}
-
-impl DrawTarget for Canvas {
-    type Color = Rgb888;
-    type Error = std::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        for Pixel(p, c) in pixels {
-            if p.x >= 0 && p.y >= 0 && (p.x as u32) < WIDTH && (p.y as u32) < HEIGHT {
-                let k = 3 * (p.y as usize * WIDTH as usize + p.x as usize);
-                self.pixels[k..k + 3].copy_from_slice(&[c.r(), c.g(), c.b()]);
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Decades spanning `lo..hi` (positive), at least one.
 fn decades(lo: f64, hi: f64) -> (i32, i32) {
     let a = lo.log10().floor() as i32;
@@ -62,9 +32,7 @@ fn decades(lo: f64, hi: f64) -> (i32, i32) {
 
 /// The chart as PNG bytes.
 pub fn png(study: &Study) -> Vec<u8> {
-    let mut c = Canvas {
-        pixels: vec![255; (WIDTH * HEIGHT * 3) as usize],
-    };
+    let mut c = Canvas::new(WIDTH, HEIGHT);
     let pts: Vec<(f64, f64, Role)> = study
         .runs
         .iter()
@@ -204,60 +172,5 @@ pub fn png(study: &Study) -> Vec<u8> {
             .draw(&mut c);
         let _ = Text::new(name, Point::new(ml + w - 120, y), text).draw(&mut c);
     }
-    encode(&c.pixels, WIDTH, HEIGHT)
-}
-
-/// A PNG chunk: length, type, data, CRC of type and data.
-fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
-    out.extend_from_slice(&(data.len() as u32).to_be_bytes());
-    out.extend_from_slice(kind);
-    out.extend_from_slice(data);
-    let mut crc = crc32fast::Hasher::new();
-    crc.update(kind);
-    crc.update(data);
-    out.extend_from_slice(&crc.finalize().to_be_bytes());
-}
-
-/// 8-bit RGB pixels, rows top to bottom, as a PNG file (no filtering).
-pub fn encode(rgb: &[u8], width: u32, height: u32) -> Vec<u8> {
-    let mut raw = Vec::with_capacity(rgb.len() + height as usize);
-    for row in rgb.chunks(3 * width as usize) {
-        raw.push(0);
-        raw.extend_from_slice(row);
-    }
-    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
-    // writing to a Vec cannot fail
-    let _ = z.write_all(&raw);
-    let idat = z.finish().unwrap_or_default();
-    let mut out = vec![0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
-    let mut ihdr = Vec::with_capacity(13);
-    ihdr.extend_from_slice(&width.to_be_bytes());
-    ihdr.extend_from_slice(&height.to_be_bytes());
-    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
-    chunk(&mut out, b"IHDR", &ihdr);
-    chunk(&mut out, b"IDAT", &idat);
-    chunk(&mut out, b"IEND", &[]);
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_png_carries_its_size_and_pixels() {
-        let px = [255, 0, 0, 0, 0, 255];
-        let b = encode(&px, 2, 1);
-        assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n");
-        assert_eq!(&b[12..16], b"IHDR");
-        assert_eq!(u32::from_be_bytes([b[16], b[17], b[18], b[19]]), 2);
-        // the pixels, each row after its filter byte (0)
-        let idat = 8 + 25;
-        let len = u32::from_be_bytes([b[idat], b[idat + 1], b[idat + 2], b[idat + 3]]) as usize;
-        let mut z = flate2::read::ZlibDecoder::new(&b[idat + 8..idat + 8 + len]);
-        let mut raw = Vec::new();
-        std::io::Read::read_to_end(&mut z, &mut raw).unwrap();
-        assert_eq!(raw, [0, 255, 0, 0, 0, 0, 255]);
-        assert_eq!(&b[b.len() - 8..b.len() - 4], b"IEND");
-    }
+    c.png()
 }
