@@ -1,13 +1,14 @@
 //! The effective inertia a force or torque input acts on (`unit::input_inertia`) against
 //! closed forms: a rigid body on a revolute joint, I + m d² about the joint, in the plane and in
 //! 3D; a bare beam root (scenes/flexible_arm.toml), held rigid ρAL³/3 (34.47 kg m²) and free
-//! below the first element's own ρAL_e³/105; a force input on a load of a rigid body, its mass.
+//! below the first element's own ρAL_e³/105; a force input on a load of a rigid body, its mass;
+//! a co-simulation cut measured but not warned about.
 
 use crate::integrator::{initial_state, Settings};
 use crate::mechanics::Mechanics;
 use crate::scene::Scene;
 use crate::unit::effects::resolve;
-use crate::unit::input_inertia::{input_inertias, InputInertia};
+use crate::unit::input_inertia::{input_inertias, InputInertia, SMALL_SHARE};
 use crate::unit::variables::VariableTable;
 
 fn inertias(scene: &Scene) -> Vec<InputInertia> {
@@ -112,7 +113,7 @@ input = true
         .iter()
         .find(|i| i.name == "push.fx")
         .expect("fx measured");
-    assert!(!fx.torque);
+    assert!(!fx.torque && !fx.drive);
     assert!((fx.effective - 2.0).abs() < 1e-12, "{}", fx.effective);
     let tz = found
         .iter()
@@ -158,4 +159,25 @@ fn the_arm_on_its_5_kg_m2_rotor_is_not_small() {
     assert!(i.effective > 5.0 && i.effective < 5.1, "{}", i.effective);
     assert!((i.rigid - 39.47).abs() < 0.01, "{}", i.rigid);
     assert!(!i.is_small());
+}
+
+#[test]
+fn a_co_simulation_cut_is_measured_but_not_small() {
+    // the split slider-crank's crank unit takes the rod's pin force and torque at its tip: a
+    // beam's end by design (the master couples it implicitly), not an actuator; held rigid, the
+    // crank pinned to the world cannot move its tip along x: no finite rigid value
+    let found = inertias(&crate::tests::common::scene(
+        "slider_crank_split_crank.toml",
+    ));
+    let fx = found
+        .iter()
+        .find(|i| i.name == "pin.fx")
+        .expect("fx measured");
+    let torque = found
+        .iter()
+        .find(|i| i.name == "pin.torque")
+        .expect("torque measured");
+    assert!(fx.rigid.is_nan(), "{}", fx.rigid);
+    assert!(torque.share() < SMALL_SHARE, "{}", torque.share());
+    assert!(found.iter().all(|i| !i.drive && !i.is_small()), "{found:?}");
 }

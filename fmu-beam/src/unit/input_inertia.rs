@@ -18,7 +18,7 @@ use crate::mechanics::Mechanics;
 use crate::unit::variables::{Binding, VariableTable};
 use nalgebra::{DMatrix, DVector};
 
-/// An input's effective inertia below this share of the rigid value is warned about at
+/// A drive input's effective inertia below this share of the rigid value is warned about at
 /// initialization. A loop tuned on the rigid inertia J_r with closed-loop bandwidth ω_c and
 /// damping ratio ζ has k_d ≈ 2ζ ω_c J_r; it over-corrects the input's own inertia when
 /// k_d h / J_eff > 2, i.e. when J_eff / J_r < ζ ω_c h. At 1 % only a loop sampled slower than
@@ -39,6 +39,10 @@ pub struct InputInertia {
     pub slot: usize,
     /// A torque (kg m², N m, rad/s) rather than a force (kg, N, m/s).
     pub torque: bool,
+    /// A joint's effort drive (`<joint>.drive.torque` or `.force`), the actuator a control loop
+    /// sets; otherwise an input load, most often the cut of a co-simulation, where a joint
+    /// between units acts on the small inertia of a beam's end by design.
+    pub drive: bool,
     /// ∂Q/∂u: the input's generalized direction, as (coordinate, value); bᵀq' is the speed of
     /// the input's own joint or frame along it.
     pub direction: Vec<(usize, f64)>,
@@ -54,9 +58,10 @@ impl InputInertia {
         self.effective / self.rigid
     }
 
-    /// Whether this input acts on an inertia far below the attached bodies' ([`SMALL_SHARE`]).
+    /// Whether this input is a drive that acts on an inertia far below the attached bodies'
+    /// ([`SMALL_SHARE`]); false where the rigid value is not measured.
     pub fn is_small(&self) -> bool {
-        self.share() < SMALL_SHARE
+        self.drive && self.share() < SMALL_SHARE
     }
 
     /// (inertia unit, effort unit, speed unit, what it acts on).
@@ -116,6 +121,8 @@ pub fn input_inertias(sys: &Mechanics, st: &GaState, table: &VariableTable) -> V
                     name: var.name.clone(),
                     slot,
                     torque: var.unit == Some("N.m"),
+                    drive: var.name.ends_with(".drive.torque")
+                        || var.name.ends_with(".drive.force"),
                     direction,
                     effective: f64::NAN,
                     rigid: f64::NAN,
@@ -158,7 +165,8 @@ pub fn input_inertias(sys: &Mechanics, st: &GaState, table: &VariableTable) -> V
             .solve(&rhs_r, 1e-12 * rigid.singular_values.max())
             .ok()
             .map(|x| (0..frames.len()).map(|i| rhs_r[i] * x[i]).sum::<f64>())
-            .filter(|&mo| mo > 0.0 && mo.is_finite());
+            // held rigid, a direction the joints then lock has no finite inertia to compare
+            .filter(|&mo| mo > 1e-12 * mobility && mo.is_finite());
         input.effective = 1.0 / mobility;
         input.rigid = rigid_mobility.map_or(f64::NAN, |mo| 1.0 / mo);
         out.push(input);

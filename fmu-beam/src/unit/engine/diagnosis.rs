@@ -3,8 +3,8 @@
 //! step fails"):
 //!
 //! (a) a force or torque input on a small effective inertia at the communication step in use
-//!     (`unit::input_inertia`): it changed at this step, and either its inertia is below
-//!     [`SMALL_SHARE`] of the rigid value or the feedback seen between the last two
+//!     (`unit::input_inertia`): it changed at this step, and either it is a drive whose
+//!     inertia is below `SMALL_SHARE` of the rigid value, or the feedback seen between the last two
 //!     communication points, k = |Δu / Δ(bᵀq')|, is beyond half the sampled loop's limit
 //!     k h / J_eff = 2 (it mixes a stiffness's share and the beam's own response in);
 //! (b) a beam without geometric stiffening spun at [`NEAR_SPIN`] × its first bending frequency
@@ -18,7 +18,6 @@
 use super::validity::beam_states;
 use super::Engine;
 use crate::error::EngineError;
-use crate::unit::input_inertia::SMALL_SHARE;
 use nalgebra::Vector3;
 
 /// A spin at this share of a beam's first bending frequency or more counts as near it: the
@@ -299,7 +298,7 @@ pub(super) fn inertia_warnings(
 ) -> Vec<String> {
     inertias
         .iter()
-        .filter(|i| i.share() < SMALL_SHARE)
+        .filter(|i| i.is_small())
         .map(|i| i.warning(h))
         .collect()
 }
