@@ -6,7 +6,9 @@ rigid), the loop over-corrects them at every step and the step fails. The unit w
 initialization, and the Discard's message names the input, its effective inertia and the
 sampled loop's limit, not a spin near a bending frequency. With a shoulder rotor and inertia on
 both sides of the elbow (two_link_arm_motors.toml) the same loop runs clean and nothing is
-warned; with the elbow's stator inertia set to 0 the elbow alone is named.
+warned; with the elbow's stator inertia set to 0 the elbow alone is named. And a loop simply
+too fast for a large enough rotor (the shipped flexible_arm_hub at 4 × the example's gains) is
+named by the gain the unit saw it apply, 1.19 × the sampled limit.
 
 The figures asserted come from `unit::input_inertia` (1 / (bᵀ M̃⁻¹ b)); the elements' own
 inertia ρAL³/105 bounds them from above (a 0.15 m element of 40 × 6 mm aluminium: 2.1e-5 kg m²;
@@ -115,3 +117,29 @@ def test_an_elbow_with_inertia_on_one_side_only_fails_and_is_named_alone(arms):
     assert "shoulder.drive.torque" not in discard  # 0.2 kg m² rotor: kd h / J = 0.09
     seen = figure(discard, r"a feedback of about ([0-9.e+-]+) N m s/rad")
     assert seen == pytest.approx(2 * DESIGN["elbow"] * OMEGA, rel=0.1)
+
+
+def test_a_loop_too_fast_for_a_rotor_is_named_by_the_gain_it_was_seen_to_apply(fmu_dir):
+    # the shipped arm on its 5 kg m² rotor (not small: 12.7 % of 39.47 kg m²) under a PD of
+    # 4 × the example's gains (kd = 1184 N m s/rad) at h = 10 ms: kd h / J = 2.4, beyond the
+    # sampled limit 2; the unit cannot know kd, it sees it as Δτ/Δω between two points
+    path = fmu_dir / "flexible_arm_hub.fmu"
+    unit = extract(path), read_model_description(path)
+    inst = Instance(*unit, name="hub")
+    try:
+        inst.initialize(0.0)
+        kp, kd, h, t = 4 * 740.0, 4 * 296.0, 0.01, 0.0
+        with pytest.raises(FMICallException):
+            while t < 2.0:
+                a, w = inst.fmu.getReal([inst.vr("hub.angle"), inst.vr("hub.speed")])
+                inst.fmu.setReal([inst.vr("hub.drive.torque")], [kp * (0.5 * min(t, 1.0) - a) - kd * w])
+                inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                t += h
+        discard = [m for s, _, m in inst.logger.messages if s == fmi2Discard][-1]
+        assert not [m for s, _, m in inst.logger.messages if s == fmi2Warning and "acts on an effective" in m]
+    finally:
+        inst.close()
+    assert inertia_named(discard, "hub") == pytest.approx(5.004, abs=0.01)
+    seen = figure(discard, r"a feedback of about ([0-9.e+-]+) N m s/rad")
+    assert seen == pytest.approx(kd, rel=0.05)
+    assert figure(discard, r"N m s/rad, ([0-9.]+) × that limit") == pytest.approx(kd * h / (2 * 5.004), rel=0.05)
