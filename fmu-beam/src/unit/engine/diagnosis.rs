@@ -60,14 +60,12 @@ impl Engine {
         self.probes[1] = Some(probe);
     }
 
-    /// After a good step: each beam's chord, for the spin of (b).
-    pub(super) fn record_chords(&mut self) {
-        let m = self.model.as_ref().expect("model built");
-        let chords = beam_states(m).into_iter().map(|b| b.chord).collect();
+    /// After a good step: each beam's chord at t, for the spin of (b).
+    pub(super) fn record_chords(&mut self, t: f64, chords: Vec<Vector3<f64>>) {
         if self.chords.len() == SPIN_POINTS {
             self.chords.pop_front();
         }
-        self.chords.push_back((m.state.t, chords));
+        self.chords.push_back((t, chords));
     }
 
     /// The failure of the step from t of size h, with the causes that hold (the state is back

@@ -527,7 +527,6 @@ impl Engine {
             }
             Ok(()) => {
                 m.applied_inputs = crate::unit::interface::inputs_ended(&m.system, m.state.t);
-                self.record_chords();
                 Ok(())
             }
         }

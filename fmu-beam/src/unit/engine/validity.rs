@@ -14,15 +14,18 @@ impl Engine {
     /// The validity monitor: a floating frame assumes small deformation. Beyond 5 % of its
     /// length it warns once per beam; beyond its length the solution has run away (a linear
     /// beam spun above its first bending frequency) and the step is refused, as it is when a
-    /// beam's chord (root to tip) is longer than the beam.
+    /// beam's chord (root to tip) is longer than the beam. A good state's chords are kept.
     pub(super) fn monitor_validity(&mut self) -> Result<(), EngineError> {
         let m = self.model.as_ref().expect("model built");
         let t = m.state.t;
-        for (g, beam) in beam_states(m).into_iter().enumerate() {
+        let beams = beam_states(m);
+        for (g, beam) in beams.iter().enumerate() {
             let frames = beam.frames.iter().map(|(n, l, d)| (n.as_str(), *l, *d));
             let head = (beam.name.as_str(), beam.length, beam.chord.norm());
             check_beam(head, frames, t, &mut self.warned[g], &mut self.messages)?;
         }
+        // the chords of a good state, for the spin a diagnosis reads
+        self.record_chords(t, beams.into_iter().map(|b| b.chord).collect());
         Ok(())
     }
 }
