@@ -88,7 +88,9 @@ def test_start_values_run_as_the_scene_with_the_values_written_in(harness, tmp_p
     declared = {v.name: v for v in md.modelVariables}
     for name in [*START_VALUES, "world.gravity.y", "arm.inertia", "hinge.initial.position"]:
         v = declared[name]
-        assert (v.causality, v.variability) == ("parameter", "fixed"), name
+        # a load's force and torque are tunable; the rest changes the assembled system
+        variability = "tunable" if name == "push.fx" else "fixed"
+        assert (v.causality, v.variability) == ("parameter", variability), name
     assert declared["arm.inertia"].unit == "kg.m2"
     assert declared["arm.mass"].unit == "kg"
     by_parameters = simulate(base, {**START_VALUES, "world.gravity.y": -1.62})
@@ -101,3 +103,52 @@ def test_start_values_run_as_the_scene_with_the_values_written_in(harness, tmp_p
     # the joint's start: 0.4 rad at 5 rad/s
     assert abs(by_parameters["hinge.angle"][0] - 0.4) < 1e-12
     assert abs(by_parameters["hinge.speed"][0] - 5.0) < 1e-9
+
+
+def test_a_master_changes_a_load_between_steps(harness, tmp_path):
+    """fmpy sets the tunable push.fx in step mode, between two doSteps: accepted, and the run
+    after it is the run of the scene packaged with that force (started from the same state:
+    the load enters only through the table, which is 0 at the start, so up to the change at 0 s
+    both are the same), while a fixed parameter set there is refused with fmi2Error."""
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Slave
+
+    base = package(harness, tmp_path, "base", PACKAGED)
+    swept = package(harness, tmp_path, "swept", dict(PACKAGED, fx=-1.0))
+
+    def run(path, change):
+        md = read_model_description(path)
+        refs = {v.name: v.valueReference for v in md.modelVariables}
+        fmu = FMU2Slave(
+            guid=md.guid,
+            unzipDirectory=extract(path),
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName="i",
+        )
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        rows = []
+        for k in range(30):
+            if change and k == 0:
+                fmu.setReal([refs["push.fx"]], [-1.0])
+                try:
+                    fmu.setReal([refs["arm.mass"]], [3.0])
+                    refused = False
+                except Exception:
+                    refused = True
+                assert refused, "a fixed parameter was accepted in step mode"
+            fmu.doStep(currentCommunicationPoint=k * 0.01, communicationStepSize=0.01)
+            rows.append(fmu.getReal([refs[n] for n in OUTPUTS]))
+        fmu.terminate()
+        fmu.freeInstance()
+        return np.array(rows)
+
+    tuned = run(base, True)
+    packaged = run(swept, False)
+    unchanged = run(base, False)
+    # the change at t = 0 met as a jump (a restart there) against a run that starts with it:
+    # the same equations from the same state, to the solver's tolerance (1e-6 by default)
+    assert np.allclose(tuned, packaged, rtol=1e-5, atol=1e-7), np.abs(tuned - packaged).max()
+    assert not np.allclose(tuned, unchanged, rtol=1e-5, atol=1e-7)

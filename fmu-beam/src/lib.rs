@@ -39,5 +39,5 @@ pub use unit::engine::Engine;
 pub use unit::interface::explain as explain_feedthrough;
 pub use unit::modes::natural_frequencies;
 pub use unit::variables::{
-    Binding, Causality, Initial, UnitDef, VarType, Variable, VariableTable, UNITS,
+    Binding, Causality, Initial, UnitDef, VarType, Variability, Variable, VariableTable, UNITS,
 };

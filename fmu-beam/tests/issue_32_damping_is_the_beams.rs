@@ -26,8 +26,11 @@ fn omega1() -> f64 {
     1.875_104_068_7_f64.powi(2) * (ei / (RHO * WIDTH * HEIGHT)).sqrt()
 }
 
-/// The cantilever scene: `dims` 2 or 3, `parts` substructures (1: one frame of 16 elements).
-fn cantilever(dims: usize, parts: usize, alpha: f64, beta: f64) -> Scene {
+/// The cantilever scene: `dims` 2 or 3, `parts` substructures (1: one frame of 16 elements),
+/// each in a floating frame of kind `frame` ("tangent" or "pinned"); with `frame = "pinned"`
+/// the beam is held at both ends instead (revolute joints at its root and at its tip, the tip's
+/// on a welded ground body; planar only).
+fn cantilever(dims: usize, parts: usize, alpha: f64, beta: f64, frame: &str) -> Scene {
     let layout = if parts == 1 {
         "elements = 16".to_string()
     } else {
@@ -54,6 +57,32 @@ fn cantilever(dims: usize, parts: usize, alpha: f64, beta: f64) -> Scene {
             ),
         )
     };
+    let supports = if frame == "pinned" {
+        r#"[[body]]
+name = "ground"
+mass = 1.0
+inertia = 1.0
+frames = { tip = [1.0, 0.0] }
+[[joint]]
+name = "fixed_ground"
+type = "weld"
+frames = ["world", "ground.origin"]
+[[joint]]
+name = "root"
+type = "revolute"
+frames = ["world", "beam.a"]
+[[joint]]
+name = "tip"
+type = "revolute"
+frames = ["ground.tip", "beam.b"]
+"#
+    } else {
+        r#"[[joint]]
+name = "clamp"
+type = "weld"
+frames = ["world", "beam.a"]
+"#
+    };
     let text = format!(
         r#"name = "decay"
 {head}
@@ -74,15 +103,12 @@ rho_inf = 1.0
 name = "beam"
 length = 1.0
 {layout}
+frame = "{frame}"
 material = {{ rho = {RHO}, E = {E}, G = 26e9 }}
 section = {section}
 rayleigh = {{ alpha = {alpha}, beta = {beta} }}
 
-[[joint]]
-name = "clamp"
-type = "weld"
-frames = ["world", "beam.a"]
-"#
+{supports}"#
     );
     let scene = Scene::from_toml_str(&text, "decay").expect("a valid scene");
     assert_eq!(
@@ -149,28 +175,45 @@ fn damping_ratio(t: &[f64], x: &[f64]) -> (f64, f64) {
     )
 }
 
-/// The tip's deflection in the plane of gravity over 1.5 s, every 1 ms.
-fn decay(dims: usize, parts: usize, alpha: f64, beta: f64) -> (f64, f64) {
-    let out = if dims == 2 {
-        "beam.tip.deflection"
-    } else {
-        "beam.tip.deflection_z"
+/// The damping ratio and log decrement of the tip's deflection in the plane of gravity (the
+/// mid-span's for a beam held at both ends) over 1.5 s, every 1 ms.
+fn decay(dims: usize, parts: usize, alpha: f64, beta: f64, frame: &str) -> (f64, f64) {
+    let out = match (dims, frame) {
+        (2, "pinned") => "beam.mid.deflection",
+        (2, _) => "beam.tip.deflection",
+        _ => "beam.tip.deflection_z",
     };
-    let run = common::run(cantilever(dims, parts, alpha, beta), &[], &[out], 1e-3, 1.5);
+    let run = common::run(
+        cantilever(dims, parts, alpha, beta, frame),
+        &[],
+        &[out],
+        1e-3,
+        1.5,
+    );
     damping_ratio(&run.column(0), &run.column(1))
 }
 
 /// Single frame and 2, 4, 8 substructures against each other and against ζ = α/(2ω) + βω/2,
 /// the damping left by the integrator (α = β = 0, ρ∞ = 1) subtracted.
 fn check(dims: usize, alpha: f64, beta: f64) {
-    let w = omega1();
+    check_frames(dims, alpha, beta, "tangent");
+}
+
+/// [`check`] with floating frames of kind `frame` ("pinned": the beam held at both ends, whose
+/// first bending frequency is π² √(EI / (ρA L⁴))).
+fn check_frames(dims: usize, alpha: f64, beta: f64, frame: &str) {
+    let w = if frame == "pinned" {
+        omega1() * (std::f64::consts::PI / 1.875_104_068_7).powi(2)
+    } else {
+        omega1()
+    };
     let exact = alpha / (2.0 * w) + beta * w / 2.0;
     let mut zetas = Vec::new();
     for parts in [1, 2, 4, 8] {
-        let (z0, _) = decay(dims, parts, 0.0, 0.0);
-        let (z, delta) = decay(dims, parts, alpha, beta);
+        let (z0, _) = decay(dims, parts, 0.0, 0.0, frame);
+        let (z, delta) = decay(dims, parts, alpha, beta, frame);
         println!(
-            "{dims}D, {parts} frame(s), alpha = {alpha}, beta = {beta}: zeta = {z:.5} \
+            "{dims}D, {parts} {frame} frame(s), alpha = {alpha}, beta = {beta}: zeta = {z:.5} \
              (log decrement {delta:.5}), undamped run {z0:.2e}, exact {exact:.5}"
         );
         assert!(
@@ -200,6 +243,15 @@ fn planar_mass_proportional_damping_is_the_same_for_any_substructuring() {
 #[test]
 fn spatial_mass_proportional_damping_is_the_same_for_any_substructuring() {
     check(3, 3.0, 0.0);
+}
+
+/// A beam held at both ends in pinned floating frames (through both ends of each substructure:
+/// the beam's reference is its chord, which the supports hold): α damps its first mode as a
+/// whole, whatever the substructuring. (A cantilever in pinned frames would damp only its
+/// deformation relative to the turning chord: docs/effects.md.)
+#[test]
+fn planar_mass_proportional_damping_of_a_beam_held_at_both_ends_in_pinned_frames() {
+    check_frames(2, 3.0, 0.0, "pinned");
 }
 
 #[test]

@@ -229,7 +229,8 @@ fn gravity_runs_as_packaged() {
     });
 }
 
-/// The new parameters are fixed: the assembled system depends on them, so they are refused
+/// The new parameters are fixed (a load's force and torque are tunable: tunable_loads.rs): the
+/// assembled system depends on them, so they are refused
 /// after initialization, and a value the scene's rules refuse (a negative mass) is refused
 /// before it, naming the variable and changing nothing.
 #[test]
@@ -244,7 +245,12 @@ fn body_load_and_law_parameters_are_fixed_and_checked_by_the_rules() {
     let err = e.set_real(row, 0.05).unwrap_err().to_string();
     assert!(err.contains("push.scale.table.t[3]"), "{err}");
     e.exit_initialization().unwrap();
-    for name in ["arm.mass", "arm.com.x", "push.fx", "hinge.drive.value"] {
+    for name in [
+        "arm.mass",
+        "arm.com.x",
+        "push.scale.table.t[2]",
+        "hinge.drive.value",
+    ] {
         let v = e.variables().by_name(name).unwrap();
         assert_eq!(v.variability.as_str(), "fixed", "{name}");
         assert!(e.set_real(v.vr, 1.0).is_err(), "{name}");

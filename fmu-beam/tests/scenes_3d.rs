@@ -118,8 +118,8 @@ fn scene_rules_of_each_dimension_name_the_field() {
             "spherical",
         ),
         (
-            format!("{SPATIAL}geometric_stiffening = true\n[world]\ngravity = [0, 0, -9.81]\n"),
-            "beam \"beam\".geometric_stiffening",
+            format!("{SPATIAL}modes = 2\n[world]\ngravity = [0, 0, -9.81]\n"),
+            "beam \"beam\".modes",
             "planar element only",
         ),
         (

@@ -186,6 +186,7 @@ fn simulate_cmd(
         stop_time: stop,
         step,
         outputs,
+        on_warning: Some(|m| eprintln!("warning from the FMU: {m}")),
     };
     let ended = match csv {
         Some(path) => write_csv_through_temporary(path, |sink| {

@@ -70,6 +70,9 @@ pub struct Options {
     pub step: Option<f64>,
     /// Variable names; empty = every output.
     pub outputs: Vec<String>,
+    /// Called with each warning the FMU logs (status fmi2Warning) as the run goes: at
+    /// initialization and after each communication step. None drops them.
+    pub on_warning: Option<fn(&str)>,
 }
 
 /// Recorded values: `rows[i][0]` is the time, then one value per column (Integer and Boolean as
@@ -269,6 +272,7 @@ pub fn simulate_into(
     slave.setup_experiment(de.tolerance, start, Some(stop))?;
     slave.enter_initialization_mode()?;
     slave.exit_initialization_mode()?;
+    pass_warnings(&mut slave, options);
     let names: Vec<String> = vars.iter().map(|v| v.name.clone()).collect();
     let types: Vec<VarType> = vars.iter().map(|v| v.var_type).collect();
     sink.columns(&names, &types)
@@ -294,6 +298,7 @@ pub fn simulate_into(
                 messages: messages.iter().map(|m| m.message.clone()).collect(),
             }));
         }
+        pass_warnings(&mut slave, options);
         t = next;
         n += 1;
         sink.row(&record(&mut slave, t, &vars)?)
@@ -301,6 +306,17 @@ pub fn simulate_into(
     }
     slave.terminate()?;
     Ok(None)
+}
+
+/// Hands the warnings the FMU logged since the last call to `options.on_warning`.
+fn pass_warnings(slave: &mut Slave, options: &Options) {
+    if let Some(warn) = options.on_warning {
+        for m in slave.take_messages() {
+            if m.status == Status::Warning {
+                warn(&m.message);
+            }
+        }
+    }
 }
 
 /// Steps the slave from `t` to `next`; a Discard is retried from the last good time with half

@@ -125,6 +125,7 @@ fn simulate_runs_the_c_fmu_on_the_closed_form_free_vibration() {
             stop_time: Some(2.0),
             step: Some(1e-2),
             outputs: vec!["x".into(), "v".into()],
+            on_warning: None,
         },
     )
     .expect("simulate the C oscillator");

@@ -914,8 +914,8 @@ pub fn study(
                      held to {SPIN_STOP} s; undamped, no gravity; output the tip's in-plane \
                      deflection in the root frame every {SPIN_COMM} s. (Ω/ω₁)² = {:.3}: the \
                      full model's quadratic-velocity terms with q_f (centrifugal softening, \
-                     Coriolis) are what the variants drop. The 3D full model has no geometric \
-                     stiffening yet, so at this spin neither is the physical answer (as in \
+                     Coriolis) are what the variants drop. The 3D models run without geometric \
+                     stiffening, so at this spin neither is the physical answer (as in \
                      planar C4, where the linear single frame runs away without it); the table \
                      measures only what the variants leave out",
                     (SPIN_OMEGA / omega1).powi(2)

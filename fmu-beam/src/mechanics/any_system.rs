@@ -5,7 +5,7 @@
 use crate::error::EngineError;
 use crate::mechanics::from_scene::SceneIndex;
 use crate::mechanics::multibody::equations::{CoordinateKind, Equations, Point, Turning};
-use crate::mechanics::multibody::law::InputValue;
+use crate::mechanics::multibody::law::{InputValue, Law};
 use crate::mechanics::multibody::sparsity::{BlockDiagonal, JacobianRows};
 use crate::mechanics::multibody::System;
 use crate::mechanics::multibody3d::System3;
@@ -40,6 +40,44 @@ impl Mechanics {
     /// The FMU inputs, to set (the unit writes each input and its derivatives here).
     pub fn inputs_mut(&mut self) -> &mut Vec<InputValue> {
         each!(self, s => &mut s.inputs)
+    }
+
+    /// Whether this system holds the world component `part` of a load's constant force (0..3:
+    /// x, y, z) or torque (3..6): a planar system holds x, y and the torque about z only.
+    pub fn holds_load_part(&self, part: usize) -> bool {
+        match self {
+            Mechanics::Planar(_) => matches!(part, 0 | 1 | 5),
+            Mechanics::Spatial(..) => part < 6,
+        }
+    }
+
+    /// Sets the world component `part` ([`Mechanics::holds_load_part`]) of the constant force
+    /// or torque of the scene load `name` (not an input load); false where the system holds
+    /// no such load or part.
+    pub fn set_load_part(&mut self, name: &str, part: usize, value: f64) -> bool {
+        if !self.holds_load_part(part) {
+            return false;
+        }
+        let slot = match self {
+            Mechanics::Planar(s) => s
+                .loads
+                .iter_mut()
+                .find(|l| l.name == name && l.inputs.is_none())
+                .map(|l| match part {
+                    0 | 1 => &mut l.force[part],
+                    _ => &mut l.torque,
+                }),
+            Mechanics::Spatial(s, _) => s
+                .loads
+                .iter_mut()
+                .filter(|l| !matches!(l.law.as_ref().map(|t| &t.law), Some(Law::Input(_))))
+                .find(|l| l.name == name)
+                .map(|l| match part {
+                    0..3 => &mut l.force[part],
+                    _ => &mut l.torque[part - 3],
+                }),
+        };
+        slot.map(|x| *x = value).is_some()
     }
 
     /// How far each body's frame lies from `before` in `after` (coordinates of this system):

@@ -258,7 +258,8 @@ pub struct BeamSpec {
     /// A rigid bar instead of a flexible beam (same mass and inertia, no deformation).
     #[serde(default)]
     pub rigid: bool,
-    /// Adds the geometric stiffness of the axial force (nonlinear strain u' + v'^2/2).
+    /// Adds the geometric stiffness of the axial force (nonlinear strain u' + v'^2/2; in 3D
+    /// u' + (v'^2 + w'^2)/2, both bending planes).
     #[serde(default)]
     pub geometric_stiffening: bool,
     /// Modal truncation: keep the lowest `modes` modes of each frame's deformation.

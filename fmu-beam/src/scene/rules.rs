@@ -587,7 +587,7 @@ pub(crate) const DEFORMED_NEEDS_FLEXIBILITY: Rule = rule(
 pub(crate) const STIFFENING_NEEDS_AXIAL: Rule = rule(
     "stiffening_needs_axial",
     &["effects"],
-    "a beam that asks for geometric stiffening needs the effect \"axial\" in the list",
+    "a beam that asks for geometric stiffening needs the effect \"axial\" in the list (the 3D element always has it)",
     Any,
     Schema::None,
 );
@@ -967,11 +967,7 @@ pub(crate) const SHEAR_MODULUS: Rule = rule(
 );
 pub(crate) const PLANAR_ELEMENT_ONLY: Rule = rule(
     "planar_element_only",
-    &[
-        "beam[].modes",
-        "beam[].geometric_stiffening",
-        "beam[].initial.tip_displacement",
-    ],
+    &["beam[].modes", "beam[].initial.tip_displacement"],
     "is available with the planar element only, and this scene runs with the 3D element",
     Spatial,
     Schema::None,
@@ -1007,7 +1003,7 @@ pub(crate) const SPHERICAL_NO_DRIVE: Rule = rule(
 pub(crate) const SPATIAL_EFFECTS: Rule = rule(
     "spatial_effects",
     &["effects[]"],
-    "with the 3D element, the effects that can be switched are gravity, flexibility, rayleigh_damping",
+    "with the 3D element, the effects that can be switched are gravity, flexibility, geometric_stiffening, rayleigh_damping",
     Spatial,
     Schema::None,
 );

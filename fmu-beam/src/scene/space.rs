@@ -11,7 +11,12 @@ use super::{EffectsSpec, Formulation, InertiaSpec, JointKind, Scene};
 use crate::scene::matrix_file;
 
 /// Effects a scene run with the 3D element can switch (the others are planar-only).
-pub const SPATIAL_EFFECTS: [&str; 3] = ["gravity", "flexibility", "rayleigh_damping"];
+pub const SPATIAL_EFFECTS: [&str; 4] = [
+    "gravity",
+    "flexibility",
+    "geometric_stiffening",
+    "rayleigh_damping",
+];
 
 pub(super) fn validate_space(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     if s.is_3d() {
@@ -133,9 +138,6 @@ fn validate_3d(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
         }
         if b.modes.is_some() {
             planar_only(&f("modes"), format!("{:?}", b.modes))?;
-        }
-        if b.geometric_stiffening {
-            planar_only(&f("geometric_stiffening"), "true".into())?;
         }
         if b.initial.tip_displacement != 0.0 {
             planar_only(

@@ -332,6 +332,8 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
         }
     }
     let on = |e: &str| names.iter().any(|n| n == e);
+    // the 3D element always computes the axial strain
+    let axial = on("axial") || (scene.is_3d() && scene.planar_reduction().is_err());
     for (i, b) in scene.beams.iter().enumerate() {
         if !on("flexibility") && b.initial.tip_displacement != 0.0 {
             return Err(ck.fail(
@@ -340,7 +342,7 @@ fn validate_effects(ck: &Checker, scene: &Scene) -> Result<(), SceneError> {
                 b.initial.tip_displacement,
             ));
         }
-        if on("geometric_stiffening") && b.geometric_stiffening && !on("axial") {
+        if on("geometric_stiffening") && b.geometric_stiffening && !axial {
             return Err(ck.fail_with(
                 &r::STIFFENING_NEEDS_AXIAL,
                 "effects",

@@ -13,4 +13,5 @@ mod planar_spatial_agreement;
 mod sparse_iteration_matrix;
 mod spatial_beam_element;
 mod spatial_jacobians;
+mod spatial_stiffening;
 mod spatial_system;

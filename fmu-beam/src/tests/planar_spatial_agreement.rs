@@ -93,7 +93,7 @@ struct Series {
 
 /// The planar engine on `file`, stepped by `grid`: `outputs` every `grid.hc`.
 fn planar(file: &str, grid: Grid, outputs: &[&str]) -> Series {
-    // the 3D element has no geometric stiffening: compare the planar engine without it
+    // the plain elements are compared here (stiffening in 3D: tests/issue_32_stiffening_3d.rs)
     let mut scene = super::common::scene(file);
     for b in &mut scene.beams {
         b.geometric_stiffening = false;

@@ -162,7 +162,7 @@ fn c2_3d(h: f64) -> Vec<(f64, f64)> {
 }
 
 fn c2_planar(h: f64) -> Vec<(f64, f64)> {
-    // the 3D element has no geometric stiffening: the planar one without it
+    // the 3D system below is built without geometric stiffening: the planar one without it
     let mut scene = super::common::scene("flexible_pendulum.toml");
     scene.beams[0].geometric_stiffening = false;
     let r = super::common::run(

@@ -7,13 +7,16 @@
 //! Every beam is made a rigid bar, the scene runs with error control at a loose tolerance, and
 //! at each of [`SAMPLES`] times the force every joint and load puts on a bar is projected on the
 //! bar's axis; a beam's axial force is the largest of these. Inputs stay at their start values.
+//! A scene that runs with the 3D element runs its rigid bars in the spatial system
+//! ([`rigid_run_3d`]), the same way.
 
 use crate::integrator::{initial_state, Settings, Stats, Stepper};
 use crate::mechanics::multibody::joint::Joint;
 use crate::mechanics::multibody::{Equations, System};
+use crate::mechanics::Mechanics;
 use crate::scene::{EffectsSpec, Scene};
 use crate::unit::effects::Effects;
-use nalgebra::{DMatrix, Vector2};
+use nalgebra::{DMatrix, Vector2, Vector3};
 
 /// Sampling times of the run.
 const SAMPLES: usize = 200;
@@ -27,8 +30,8 @@ pub struct AxialLoad {
     pub at: f64,
 }
 
-/// The axial load of each scene beam (in scene order), or why the run failed.
-pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
+/// The scene with every beam a rigid bar, its effects, and the run's settings.
+fn rigid_scene(scene: &Scene) -> (Scene, Effects, Settings) {
     let mut rigid = scene.clone();
     for b in &mut rigid.beams {
         b.rigid = true;
@@ -37,16 +40,23 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
     }
     rigid.effects = EffectsSpec::Mode("scene".into());
     let effects: Effects = crate::unit::effects::resolve(&rigid).effects;
-    let sys = System::build(&rigid, &effects);
     let (t0, stop) = (scene.experiment.start_time, scene.experiment.stop_time);
-    let dt = (stop - t0) / SAMPLES as f64;
     let settings = Settings {
         adaptive: true,
         tolerance: 1e-4,
-        max_step: dt,
+        max_step: (stop - t0) / SAMPLES as f64,
         rho_inf: scene.solver.rho_inf,
         step_budget: crate::integrator::DEFAULT_STEP_BUDGET,
     };
+    (rigid, effects, settings)
+}
+
+/// The axial load of each scene beam (in scene order), or why the run failed.
+pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
+    let (rigid, effects, settings) = rigid_scene(scene);
+    let sys = System::build(&rigid, &effects);
+    let t0 = scene.experiment.start_time;
+    let dt = settings.max_step;
     let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
     let mut stepper = Stepper::new(&sys, settings);
     let mut stats = Stats::default();
@@ -76,6 +86,58 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
                 .iter()
                 .filter(|l| sys.frame_body(l.frame) == Some(body))
                 .map(|l| sys.load_value(l, t).0);
+            for f in joints.chain(external) {
+                let axial = f.dot(&axis).abs();
+                if axial > load.force {
+                    *load = AxialLoad {
+                        force: axial,
+                        at: t,
+                    };
+                }
+            }
+        }
+    }
+    Ok(loads)
+}
+
+/// [`rigid_run`] of a scene that runs with the 3D element: each bar's axis is its frame's x.
+pub fn rigid_run_3d(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
+    let (rigid, effects, settings) = rigid_scene(scene);
+    let Mechanics::Spatial(sys, index) = Mechanics::build(&rigid, &effects) else {
+        return Err("the scene runs with the planar element".into());
+    };
+    let t0 = scene.experiment.start_time;
+    let dt = settings.max_step;
+    let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
+    let mut stepper = Stepper::new(&sys, settings);
+    let mut stats = Stats::default();
+    let mut gm = DMatrix::zeros(sys.m(), sys.n());
+    let mut loads = vec![AxialLoad { force: 0.0, at: t0 }; scene.beams.len()];
+    for k in 0..=SAMPLES {
+        let t = t0 + k as f64 * dt;
+        if k > 0 {
+            stepper
+                .step_to(&sys, &mut st, &mut stats, t)
+                .map_err(|e| e.to_string())?;
+        }
+        sys.constraint_jacobian(&st.q, t, &mut gm);
+        for (load, bodies) in loads.iter_mut().zip(&index.beam_bodies) {
+            let (body, o) = (bodies.start, sys.offsets[bodies.start]);
+            let (_, _, a) =
+                crate::mechanics::multibody3d::body::frame_of(&sys.body_coords(body, &st.q));
+            let axis = a.column(0).into_owned();
+            // each joint's force on the bar: its rows' Jacobian on the bar's position, times λ
+            let joints = sys.joints.iter().enumerate().map(|(j, jt)| {
+                let first = sys.joint_row(j);
+                (first..first + jt.len()).fold(Vector3::zeros(), |f, r| {
+                    f + Vector3::new(gm[(r, o)], gm[(r, o + 1)], gm[(r, o + 2)]) * st.lambda[r]
+                })
+            });
+            let external = sys
+                .loads
+                .iter()
+                .filter(|l| sys.frames[l.frame].body() == Some(body))
+                .map(|l| l.force * sys.load_scale(l, t));
             for f in joints.chain(external) {
                 let axial = f.dot(&axis).abs();
                 if axial > load.force {

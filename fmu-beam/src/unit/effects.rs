@@ -23,6 +23,7 @@ pub use crate::scene::rules::EFFECTS;
 
 mod cost;
 mod explain;
+mod spatial;
 
 use cost::{coordinates, nodal_coordinates, shape_read_cost, step_cost};
 
@@ -138,6 +139,83 @@ fn law_max_rate(law: &LawSpec) -> f64 {
     }
 }
 
+/// The fastest spin (rad/s) of the scene: a revolute joint's fastest motion-drive law, or the
+/// speed it starts at.
+fn spin_rate(scene: &Scene) -> f64 {
+    scene
+        .joints
+        .iter()
+        .filter(|j| j.kind == JointKind::Revolute)
+        .map(|j| {
+            let driven = j
+                .drive
+                .as_ref()
+                .filter(|d| d.kind == DriveKind::Motion)
+                .map_or(0.0, |d| law_max_rate(&d.law));
+            let start = j.initial.as_ref().and_then(|i| i.speed).unwrap_or(0.0);
+            driven.max(start.abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `auto`'s reason for geometric stiffening of a flexible beam whose first bending frequency
+/// is `w1` (rad/s) and buckling load `buckling` (N), at the scene's `spin` (rad/s) and with
+/// the axial force of a rigid-body run (`None` when unknown); `None` when neither criterion
+/// holds.
+fn stiffening_reason(
+    spin: f64,
+    w1: f64,
+    buckling: f64,
+    axial_force: Option<crate::unit::axial_load::AxialLoad>,
+) -> Option<String> {
+    if spin >= SPIN_RATIO * w1 {
+        return Some(format!(
+            "spin up to {spin:.3} rad/s is {:.2} x the first bending frequency {w1:.3} rad/s \
+             (>= {SPIN_RATIO}): centrifugal stiffening matters",
+            spin / w1
+        ));
+    }
+    axial_force
+        .filter(|a| a.force >= AXIAL_SHARE * buckling)
+        .map(|a| {
+            format!(
+                "a rigid-body run of the experiment puts an axial force of {:.3e} N on \
+                 the beam (at t = {:.3} s), {:.1} % of its buckling load π²EI/L² = \
+                 {buckling:.3e} N (>= {:.0} %): the geometric stiffness changes its \
+                 bending stiffness by about as much",
+                a.force,
+                a.at,
+                100.0 * a.force / buckling,
+                100.0 * AXIAL_SHARE
+            )
+        })
+}
+
+/// `auto`'s reason for leaving geometric stiffening off (see [`stiffening_reason`]); `axial`
+/// the rigid-body run's outcome.
+fn no_stiffening_reason(
+    spin: f64,
+    w1: f64,
+    buckling: f64,
+    axial: &Result<Vec<crate::unit::axial_load::AxialLoad>, String>,
+    axial_force: Option<crate::unit::axial_load::AxialLoad>,
+) -> String {
+    let load = match (axial, axial_force) {
+        (_, Some(a)) => format!(
+            "; the largest axial force of a rigid-body run, {:.3e} N, is {:.2} % of its \
+             buckling load {buckling:.3e} N",
+            a.force,
+            100.0 * a.force / buckling
+        ),
+        (Err(e), _) => format!("; its axial force is not known (the rigid-body run failed: {e})"),
+        _ => String::new(),
+    };
+    format!(
+        "spin {spin:.3} rad/s is below {SPIN_RATIO} x the first bending frequency {w1:.3} \
+         rad/s{load}"
+    )
+}
+
 /// What excites the scene: the bandwidth (rad/s) and the source that sets it.
 fn excitation(scene: &Scene) -> (f64, String) {
     let h = scene.experiment.step_size;
@@ -216,7 +294,7 @@ pub fn resolve(scene: &Scene) -> Resolution {
                 );
                 r
             }
-            Err(why) => spatial(scene, &why),
+            Err(why) => spatial::resolve(scene, &why),
         };
     }
     let all = || BeamOptions::default();
@@ -300,129 +378,6 @@ fn mode_reason(scene: &Scene, every: bool, effect: &str, subject: &str) -> Strin
     }
 }
 
-/// A scene that runs with the 3D element: gravity, flexibility and Rayleigh damping can be
-/// switched (`crate::scene::SPATIAL_EFFECTS`); the element's other terms are always on. No
-/// cost model (cost shares 0).
-fn spatial(scene: &Scene, why_3d: &str) -> Resolution {
-    use crate::scene::EffectsSpec;
-    // what the mode settles itself (None: auto decides)
-    let (mode, listed): (&'static str, &[String]) = match &scene.effects {
-        EffectsSpec::List(names) => ("list", names),
-        EffectsSpec::Mode(m) if m == "auto" => ("auto", &[]),
-        EffectsSpec::Mode(m) if m == "all" => ("all", &[]),
-        EffectsSpec::Mode(_) => ("scene", &[]),
-    };
-    let on = |e: &str| match mode {
-        "list" => Some(listed.iter().any(|n| n == e)),
-        "all" | "scene" => Some(true),
-        _ => None,
-    };
-    let reason = |auto: &str| match mode {
-        "list" => "listed in `effects`".to_string(),
-        "all" => "effects = \"all\": every effect".to_string(),
-        "scene" => "effects = \"scene\" (the default): every term of the element".to_string(),
-        _ => auto.to_string(),
-    };
-    let field = scene.world.gravity != [0.0; 3];
-    let gravity = on("gravity").unwrap_or(field);
-    let mut decisions = vec![
-        Decision {
-            effect: "formulation",
-            subject: "scene".into(),
-            setting: "spatial".into(),
-            why: format!("the 3D element: {why_3d}"),
-            cost_share: 0.0,
-        },
-        Decision {
-            effect: "gravity",
-            subject: "scene".into(),
-            setting: on_off(gravity),
-            why: reason(if field {
-                "a gravity field"
-            } else {
-                "no gravity field"
-            }),
-            cost_share: 0.0,
-        },
-    ];
-    let mut beams = Vec::new();
-    for b in &scene.beams {
-        let rigid = b.rigid || !on("flexibility").unwrap_or(true);
-        let damped = b.rayleigh.alpha != 0.0 || b.rayleigh.beta != 0.0;
-        let damping = on("rayleigh_damping").unwrap_or(damped);
-        decisions.push(Decision {
-            effect: "flexibility",
-            subject: b.name.clone(),
-            setting: on_off(!rigid),
-            why: if b.rigid {
-                "the scene makes the beam rigid (rigid = true)".into()
-            } else {
-                reason("auto never makes a flexible beam rigid")
-            },
-            cost_share: 0.0,
-        });
-        if !rigid {
-            // the 3D element's terms that cannot be switched, listed so that `explain` shows
-            // exactly what is on
-            let always = |effect: &'static str, why: &str| Decision {
-                effect,
-                subject: b.name.clone(),
-                setting: "on".into(),
-                why: format!("the 3D element always computes {why}"),
-                cost_share: 0.0,
-            };
-            decisions.push(always("axial", "axial deformation"));
-            decisions.push(always(
-                "quadratic_velocity",
-                "the centrifugal and Coriolis terms",
-            ));
-            decisions.push(Decision {
-                effect: "geometric_stiffening",
-                subject: b.name.clone(),
-                setting: "off".into(),
-                why: format!(
-                    "{}the 3D element has no geometric stiffening: substructures carry the \
-                     stiffening of large deflection (docs/3d.md)",
-                    if mode == "all" {
-                        "effects = \"all\" cannot turn it on: "
-                    } else {
-                        ""
-                    }
-                ),
-                cost_share: 0.0,
-            });
-            decisions.push(Decision {
-                effect: "rayleigh_damping",
-                subject: b.name.clone(),
-                setting: on_off(damping),
-                why: format!(
-                    "{}: alpha = {}, beta = {}",
-                    reason(if damped {
-                        "damping coefficients given"
-                    } else {
-                        "both damping coefficients are zero"
-                    }),
-                    b.rayleigh.alpha,
-                    b.rayleigh.beta
-                ),
-                cost_share: 0.0,
-            });
-        }
-        beams.push(BeamEffects {
-            rigid,
-            options: BeamOptions {
-                damping,
-                ..BeamOptions::default()
-            },
-        });
-    }
-    Resolution {
-        mode,
-        effects: Effects { gravity, beams },
-        decisions,
-    }
-}
-
 /// `effects = "auto"`: the rules of the module documentation, each decision with its reason.
 fn auto(scene: &Scene) -> Resolution {
     let mut why: Vec<(&'static str, String, String)> = Vec::new();
@@ -438,21 +393,7 @@ fn auto(scene: &Scene) -> Resolution {
     ));
     let (bandwidth, source) = excitation(scene);
     let still = non_rotating(scene);
-    // a revolute joint's fastest drive law, or the speed it starts at
-    let spin = scene
-        .joints
-        .iter()
-        .filter(|j| j.kind == JointKind::Revolute)
-        .map(|j| {
-            let driven = j
-                .drive
-                .as_ref()
-                .filter(|d| d.kind == DriveKind::Motion)
-                .map_or(0.0, |d| law_max_rate(&d.law));
-            let start = j.initial.as_ref().and_then(|i| i.speed).unwrap_or(0.0);
-            driven.max(start.abs())
-        })
-        .fold(0.0, f64::max);
+    let spin = spin_rate(scene);
     // the axial force of each beam, from a rigid-body run (only where a beam could need it)
     let axial = if scene
         .beams
@@ -484,27 +425,8 @@ fn auto(scene: &Scene) -> Resolution {
         let axial_force = axial.as_ref().ok().map(|a| a[i]);
         let reason = if b.rigid {
             None
-        } else if spin >= SPIN_RATIO * w1 {
-            Some(format!(
-                "spin up to {spin:.3} rad/s is {:.2} x the first bending frequency {w1:.3} rad/s \
-                 (>= {SPIN_RATIO}): centrifugal stiffening matters",
-                spin / w1
-            ))
         } else {
-            axial_force
-                .filter(|a| a.force >= AXIAL_SHARE * buckling)
-                .map(|a| {
-                    format!(
-                        "a rigid-body run of the experiment puts an axial force of {:.3e} N on \
-                         the beam (at t = {:.3} s), {:.1} % of its buckling load π²EI/L² = \
-                         {buckling:.3e} N (>= {:.0} %): the geometric stiffness changes its \
-                         bending stiffness by about as much",
-                        a.force,
-                        a.at,
-                        100.0 * a.force / buckling,
-                        100.0 * AXIAL_SHARE
-                    )
-                })
+            stiffening_reason(spin, w1, buckling, axial_force)
         };
         if let Some(reason) = reason {
             o.geometric_stiffening = true;
@@ -516,25 +438,10 @@ fn auto(scene: &Scene) -> Resolution {
                 "asked for by the beam".into(),
             ));
         } else {
-            let load = match (&axial, axial_force) {
-                (_, Some(a)) => format!(
-                    "; the largest axial force of a rigid-body run, {:.3e} N, is {:.2} % of its \
-                     buckling load {buckling:.3e} N",
-                    a.force,
-                    100.0 * a.force / buckling
-                ),
-                (Err(e), _) => {
-                    format!("; its axial force is not known (the rigid-body run failed: {e})")
-                }
-                _ => String::new(),
-            };
             why.push((
                 "geometric_stiffening",
                 n.clone(),
-                format!(
-                    "spin {spin:.3} rad/s is below {SPIN_RATIO} x the first bending frequency \
-                     {w1:.3} rad/s{load}"
-                ),
+                no_stiffening_reason(spin, w1, buckling, &axial, axial_force),
             ));
         }
         // axial deformation: where the stiffening needs the axial strain, or where the

@@ -99,6 +99,7 @@ pub fn run_fmu(
         stop_time: stop,
         step,
         outputs: Vec::new(),
+        on_warning: Some(|m| eprintln!("warning from the FMU: {m}")),
     };
     // A run the FMU ended early is drawn up to its last good time; the CSV and the page
     // show where it stops.

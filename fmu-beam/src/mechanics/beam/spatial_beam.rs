@@ -27,16 +27,22 @@
 //! ([`UndeformedInertia::from_nodal_mass`]), so a beam whose 12 × 12 matrices come from a file
 //! ([`crate::scene::matrix_file`]) gets exactly the same treatment.
 //!
+//! Geometric stiffening (off unless switched on): the nonlinear axial strain of
+//! `spatial_beam/stiffening.rs`, its force f_g one more product of the state.
+//!
 //! Over 600 lines: the spatial beam's inertia (full and frozen), its products, forces and energies
 //! share the shape integrals' private layout (its construction is `spatial_beam/build.rs`).
 
 use super::planar_element::GAUSS_4;
-use super::spatial_element::{self, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
+use super::spatial_element::{self, Row, ELEMENT_DOFS, NODE_DOFS, TX, TY, TZ, U, V, W};
 use super::spatial_section::SpatialSection;
 use super::FloatingFrame;
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix3, Rotation3, Vector3};
 
 mod build;
+mod stiffening;
+
+pub use stiffening::Stiffening;
 
 /// Index of ω in the velocity vector; q̇_f starts at [`FLEX`].
 pub const OMEGA: usize = 3;
@@ -172,6 +178,7 @@ pub struct BeamProducts {
     dfd: DVector<f64>,
     mfdd: DVector<f64>,
     skew_fd: Vec<DVector<f64>>,
+    stiffening: Option<Stiffening>,
 }
 
 /// Copies in place on `clone_from` (a tangent column starts from the state's products without
@@ -208,6 +215,7 @@ impl Clone for BeamProducts {
             dfd: self.dfd.clone(),
             mfdd: self.mfdd.clone(),
             skew_fd: self.skew_fd.clone(),
+            stiffening: self.stiffening.clone(),
         }
     }
 
@@ -220,6 +228,10 @@ impl Clone for BeamProducts {
             .iter_mut()
             .zip(&source.skew_fd)
             .for_each(|(x, y)| x.copy_from(y));
+        match (self.stiffening.as_mut(), source.stiffening.as_ref()) {
+            (Some(x), Some(y)) => x.copy_from(y),
+            _ => self.stiffening = source.stiffening.clone(),
+        }
     }
 }
 
@@ -318,6 +330,12 @@ pub struct SpatialBeam {
     pub flange_a: SpatialPointMap,
     /// Flange b: the material point at the tip (x = length).
     pub flange_b: SpatialPointMap,
+    /// Nonlinear axial strain ε = u' + ½(v'² + w'²) (geometric stiffening), when on.
+    pub geometric_stiffening: bool,
+    /// Axial stiffness EA (N) of the stiffening (a matrix file's: its first axial entry × ℓ).
+    pub ea: f64,
+    /// The element's slope rows and kept indices, constant per frame.
+    strain: stiffening::StrainRows,
 }
 
 /// Full nodal indices a frame kind keeps: tangent removes the 6 root coordinates; pinned
@@ -468,12 +486,16 @@ impl SpatialBeam {
             dfd: &self.dff * fd,
             mfdd: &self.mff * fdd,
             skew_fd,
+            stiffening: self.stiffening(&f),
         }
     }
 
     /// Updates `pr` for q_f moved by `h` in coordinate `k` (`f` the moved q_f).
     pub fn shift_flex(&self, pr: &mut BeamProducts, f: DVectorView<f64>, k: usize, h: f64) {
         pr.kf.axpy(h, &self.kff.column(k), 1.0);
+        if let Some(st) = pr.stiffening.as_mut() {
+            self.shift_stiffening(st, k, h);
+        }
         let Some(s) = self.full() else { return };
         let Some((mf, mtf)) = pr.inertia.products.as_mut() else {
             unreachable!("the full model keeps its products")
@@ -622,17 +644,21 @@ impl SpatialBeam {
         q
     }
 
-    /// Internal force K_ff q_f + D_ff q̇_f on the deformation rows.
+    /// Internal force K_ff q_f + f_g + D_ff q̇_f on the deformation rows.
     pub fn internal_force<'a>(
         &self,
         f: impl Into<DVectorView<'a, f64>>,
         fd: impl Into<DVectorView<'a, f64>>,
     ) -> DVector<f64> {
         let (f, fd) = (f.into(), fd.into());
-        &self.kff * f + &self.dff * fd
+        let linear = &self.kff * f + &self.dff * fd;
+        match self.stiffening(&f) {
+            Some(st) => linear + st.force(),
+            None => linear,
+        }
     }
 
-    /// Residual r = M v̇ + h + [0; 0; K_ff q_f + D_ff q̇_f] − Q_g (ndof).
+    /// Residual r = M v̇ + h + [0; 0; K_ff q_f + f_g + D_ff q̇_f] − Q_g (ndof).
     pub fn residual<'a>(
         &self,
         a: &Matrix3<f64>,
@@ -677,6 +703,9 @@ impl SpatialBeam {
         let mut rf = r.rows_mut(FLEX, nf);
         rf += sbar.tr_mul(&(rd_body - gl)) + fi.ithf.tr_mul(&wd) + &pr.mfdd;
         rf += &pr.kf + &pr.dfd;
+        if let Some(st) = &pr.stiffening {
+            rf += st.force();
+        }
         r
     }
 
@@ -691,10 +720,10 @@ impl SpatialBeam {
         0.5 * v.dot(&(self.mass_matrix_owned(a, f) * v))
     }
 
-    /// Strain energy ½ q_fᵀ K_ff q_f (J).
+    /// Strain energy ½ q_fᵀ K_ff q_f + U_g (J).
     pub fn strain_energy<'a>(&self, f: impl Into<DVectorView<'a, f64>>) -> f64 {
         let f = f.into();
-        0.5 * f.dot(&(&self.kff * f))
+        0.5 * f.dot(&(&self.kff * f)) + self.stiffening_energy(&f)
     }
 
     /// Potential energy of gravity −g·∫ρ r dx (J).

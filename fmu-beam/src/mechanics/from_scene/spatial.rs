@@ -163,6 +163,11 @@ pub fn from_scene(scene: &Scene, effects: &Effects) -> (System3, SceneIndex) {
                 rot,
             )
         };
+        for body in sys.beams[g].bodies.clone() {
+            if let Body3::Beam(frame) = &mut sys.bodies[body] {
+                frame.set_geometric_stiffening(fx.options.geometric_stiffening);
+            }
+        }
         owners.push((b.name.clone(), Owner::Beam(g), rot));
         index.beam_bodies.push(sys.beams[g].bodies.clone());
     }

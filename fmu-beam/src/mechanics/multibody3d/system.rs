@@ -497,7 +497,8 @@ impl System3 {
         out
     }
 
-    fn load_scale(&self, l: &Load3, t: f64) -> f64 {
+    /// The factor on load `l` at time t (1 without a law).
+    pub fn load_scale(&self, l: &Load3, t: f64) -> f64 {
         l.law
             .as_ref()
             .map_or(1.0, |law| law.eval(t, &self.inputs).0)

@@ -15,6 +15,7 @@ mod parameters;
 mod setting;
 mod start;
 mod state;
+mod tunable_loads;
 mod validity;
 
 use outputs::output;
@@ -50,6 +51,8 @@ struct Model {
     /// them (`interface::inputs_ended`): when the inputs set for the next step jump from them,
     /// the scheme restarts from accelerations consistent with the new inputs.
     applied_inputs: Vec<f64>,
+    /// The tunable load components the last step had (one per `Engine::load_parts`).
+    applied_loads: Vec<f64>,
     /// System joint index of each scene joint, system body index of each scene body.
     joint_index: Vec<usize>,
     body_index: Vec<usize>,
@@ -65,6 +68,7 @@ struct ModelState {
     back: Option<GaState>,
     stats: Stats,
     applied_inputs: Vec<f64>,
+    applied_loads: Vec<f64>,
     memory: Memory,
 }
 
@@ -115,6 +119,8 @@ pub struct Engine {
     feedthrough: crate::unit::interface::Feedthrough,
     /// The scene's fingerprint: FMU states carry it, and only states of this model are restored.
     identity: u64,
+    /// The tunable load components, in the order of `Model::applied_loads`.
+    load_parts: Vec<tunable_loads::LoadPart>,
 }
 
 impl Engine {
@@ -129,7 +135,9 @@ impl Engine {
             .map(|v| v.start.unwrap_or(0.0))
             .collect();
         let identity = Engine::identity_of(&scene);
+        let load_parts = tunable_loads::load_parts(&table, &scene);
         Engine {
+            load_parts,
             input_ders: vec![[0.0; 2]; values.len()],
             warned: vec![false; scene.beams.len()],
             split_reported: Vec::new(),
@@ -221,6 +229,7 @@ impl Engine {
     /// An input that changes while the integrator is past this point has its last step redone
     /// with the inputs as they were, to land here.
     fn sync_inputs(&mut self, t0: f64, h: f64) -> Result<(), EngineError> {
+        let loads = self.wanted_loads();
         let Some(m) = &mut self.model else {
             return Ok(());
         };
@@ -238,9 +247,13 @@ impl Engine {
         let applied = flat_inputs(&m.system);
         let changed = crate::unit::interface::inputs_changed(&m.applied_inputs, &applied);
         m.lands = !applied.is_empty() && changed;
-        // a jump is a change of some parts
-        let jump =
-            changed && crate::unit::interface::inputs_jump(&m.applied_inputs, &applied, &m.system);
+        // a jump is a change of some parts, or of a tunable load
+        let loads_changed = m.loads_changed(&loads);
+        let jump = loads_changed
+            || (changed
+                && crate::unit::interface::inputs_jump(&m.applied_inputs, &applied, &m.system));
+        // the loads the last step had, until the jump is met
+        tunable_loads::write_loads(&mut m.system, &self.load_parts, &m.applied_loads);
         if jump || (changed && m.is_past(t0)) {
             // the inputs as the last step ended them (set_real wrote the new ones in already)
             let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
@@ -256,9 +269,14 @@ impl Engine {
             } else {
                 m.system.inputs().to_vec()
             };
-            m.meet_inputs(t0, h, jump, ended)?;
+            let parts = &self.load_parts;
+            m.meet_inputs(t0, h, jump, ended, |sys| {
+                tunable_loads::write_loads(sys, parts, &loads)
+            })?;
         }
+        tunable_loads::write_loads(&mut m.system, &self.load_parts, &loads);
         m.applied_inputs = applied;
+        m.applied_loads = loads;
         Ok(())
     }
 
@@ -448,6 +466,7 @@ impl Engine {
             self.model = Some(Model {
                 shape,
                 applied_inputs: flat_inputs(&system),
+                applied_loads: self.wanted_loads(),
                 stepper: Stepper::new(&system, settings),
                 lands: !system.inputs().is_empty(),
                 system,

@@ -5,6 +5,7 @@ use super::{Model, ModelState};
 use crate::error::EngineError;
 use crate::integrator::{self, GaState};
 use crate::mechanics::multibody::law::InputValue;
+use crate::mechanics::Mechanics;
 
 /// Within this fraction of `max_step` of a communication point, the integrator's state counts
 /// as on it (not past it).
@@ -20,17 +21,21 @@ impl Model {
     /// `ended` the ones the last step ended with: lands the integrator on t0 if it stepped past
     /// it (its last step redone from the state before it, with the inputs it had), and where the
     /// inputs jump, restarts the scheme there from the consistent accelerations with `ended` and
-    /// meets the jump. The front is replaced only when all of it succeeded.
+    /// meets the jump; `next_loads` writes the tunable loads of the step to come into the system
+    /// (it holds the last step's until then). The front is replaced only when all of it
+    /// succeeded.
     pub(super) fn meet_inputs(
         &mut self,
         t0: f64,
         h: f64,
         jump: bool,
         ended: Vec<InputValue>,
+        next_loads: impl FnOnce(&mut Mechanics),
     ) -> Result<(), EngineError> {
         let next = std::mem::replace(self.system.inputs_mut(), ended);
         let landed = self.land_with_ended_inputs(t0, jump);
         *self.system.inputs_mut() = next;
+        next_loads(&mut self.system);
         let (mut st, before) = landed?;
         if let Some(before) = before {
             let step = self.stepper.next_step(&st).min(h);
@@ -95,6 +100,7 @@ impl Model {
             back: self.back.clone(),
             stats: self.stats,
             applied_inputs: self.applied_inputs.clone(),
+            applied_loads: self.applied_loads.clone(),
             memory: self.stepper.memory().clone(),
         }
     }
@@ -105,6 +111,7 @@ impl Model {
         self.back = s.back;
         self.stats = s.stats;
         self.applied_inputs = s.applied_inputs;
+        self.applied_loads = s.applied_loads;
         self.stepper.restore_memory(s.memory);
     }
 

@@ -128,8 +128,14 @@ impl Engine {
             self.apply(c);
         }
         if let Some(settings) = settings {
+            let loads = self.wanted_loads();
             match &mut self.model {
-                Some(m) if self.initialized => m.stepper.set_settings(settings),
+                Some(m) if self.initialized => {
+                    m.stepper.set_settings(settings);
+                    // what the outputs at this point see; the step to come meets the change
+                    tunable_loads::write_loads(&mut m.system, &self.load_parts, &loads);
+                    self.feedthrough = Default::default();
+                }
                 _ => self.model = None,
             }
         }
@@ -175,6 +181,17 @@ impl Engine {
                 name,
                 reason: "it is a fixed parameter and the instance is past initialization".into(),
             });
+        }
+        if let (true, Binding::Parameter(target), Some(m)) =
+            (self.initialized, var.binding, &self.model)
+        {
+            if tunable_loads::part_of(target).is_some_and(|p| !m.system.holds_load_part(p)) {
+                return Err(EngineError::NotSettable {
+                    name,
+                    reason: "the scene runs as planar and this component is out of its plane"
+                        .into(),
+                });
+            }
         }
         Ok(Change::Parameter { i, value })
     }

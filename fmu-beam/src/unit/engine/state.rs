@@ -8,7 +8,7 @@ use crate::error::EngineError;
 use crate::integrator::{write_vec, GaState, Memory, Reader, Stats};
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
-const STATE_VERSION: u32 = 6;
+const STATE_VERSION: u32 = 7;
 
 /// FNV-1a (64 bit) of `bytes` from `seed`: the scene's fingerprint and the serialized state's
 /// checksum. Any one changed byte changes it (each step is a bijection of the running value).
@@ -84,9 +84,11 @@ impl Engine {
                 message: "the state does not belong to this model".into(),
             });
         }
-        if saved.applied_inputs.len() != m.applied_inputs.len() {
+        if saved.applied_inputs.len() != m.applied_inputs.len()
+            || saved.applied_loads.len() != m.applied_loads.len()
+        {
             return Err(EngineError::BadState {
-                message: "the state has another number of inputs".into(),
+                message: "the state has another number of inputs or tunable loads".into(),
             });
         }
         m.put_back(saved.clone());
@@ -130,6 +132,7 @@ impl Engine {
                 }
                 ms.stats.write(&mut w);
                 write_vec(&mut w, &ms.applied_inputs);
+                write_vec(&mut w, &ms.applied_loads);
                 ms.memory.write(&mut w);
             }
         }
@@ -197,6 +200,7 @@ impl Engine {
                     back,
                     stats: Stats::read(&mut r)?,
                     applied_inputs: r.vec()?,
+                    applied_loads: r.vec()?,
                     memory: Memory::read(&mut r)?,
                 })
             }
@@ -222,7 +226,8 @@ impl Engine {
                         .all(|x| x.iter().all(|v| v.is_finite()))
             };
             let states = [Some(&m.state), Some(&m.front), m.back.as_ref()];
-            if !states.into_iter().flatten().all(finite) {
+            let mut applied = m.applied_inputs.iter().chain(&m.applied_loads);
+            if !states.into_iter().flatten().all(finite) || !applied.all(|v| v.is_finite()) {
                 return Err(bad("non-finite values in the integration state"));
             }
         }

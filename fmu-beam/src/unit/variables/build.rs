@@ -633,10 +633,25 @@ fn body_parameters(t: &mut Builder, scene: &Scene) {
 }
 
 /// Each load's force and torque (named as the inputs of a load with `input = true` are) and
-/// its scale law's numbers; a load read from inputs has only its inputs.
+/// its scale law's numbers; a load read from inputs has only its inputs. The components the
+/// running system holds are tunable (a change between steps is met as an input's jump is);
+/// a 3D scene that runs as planar keeps its out-of-plane ones fixed, and a law stays fixed.
 fn load_parameters(t: &mut Builder, scene: &Scene) {
     use ParamTarget as T;
     let fixed = Variability::Fixed;
+    let runs_planar = !scene.is_3d() || scene.planar_reduction().is_ok();
+    let variability = |target: T| {
+        let part = match target {
+            T::LoadForce(_, k) => k,
+            T::LoadTorque(_, k) => 3 + k,
+            _ => return fixed,
+        };
+        if !runs_planar || matches!(part, 0 | 1 | 5) {
+            Variability::Tunable
+        } else {
+            fixed
+        }
+    };
     for (i, l) in scene.loads.iter().enumerate().filter(|(_, l)| !l.input) {
         let n = &l.name;
         let (f, m) = (l.force, l.torque);
@@ -662,7 +677,7 @@ fn load_parameters(t: &mut Builder, scene: &Scene) {
                 target,
                 unit,
                 v,
-                fixed,
+                variability(target),
                 &format!("Load on {}: {desc} ({what})", l.frame),
             );
         }

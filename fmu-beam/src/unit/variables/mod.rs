@@ -53,15 +53,21 @@ impl Causality {
     }
 }
 
+/// The FMI `variability` attribute of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variability {
+    /// A parameter set before fmi2ExitInitializationMode only.
     Fixed,
+    /// A parameter a master may change between communication steps.
     Tunable,
+    /// Changes only at events (the unit's counters and flags).
     Discrete,
+    /// Changes continuously in time.
     Continuous,
 }
 
 impl Variability {
+    /// The attribute value in modelDescription.xml.
     pub fn as_str(self) -> &'static str {
         match self {
             Variability::Fixed => "fixed",

@@ -81,8 +81,11 @@ impl SpatialBeam {
             integrals: None,
             undeformed,
             mff,
+            ea: stiffness[(U, U)] * length / elements as f64,
             kff,
             dff,
+            geometric_stiffening: false,
+            strain: stiffening::StrainRows::new(length, elements, &kept),
             flange_a: SpatialPointMap {
                 s0: Vector3::zeros(),
                 sp: DMatrix::zeros(3, kept.len()),
