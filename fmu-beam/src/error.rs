@@ -108,9 +108,7 @@ pub enum EngineError {
     },
     #[error(
         "beam '{beam}': deflection {deflection:.3e} m of a floating frame exceeds the frame's \
-         length {length} m at t = {t} s: the solution has run away (a linear frame spun near or \
-         above its first bending frequency softens without bound); use (more) substructures or \
-         geometric_stiffening"
+         length {length} m at t = {t} s: the solution has run away"
     )]
     /// A floating frame's transverse deflection exceeds its length: the linear model has run
     /// away.
@@ -126,8 +124,7 @@ pub enum EngineError {
     },
     #[error(
         "beam '{beam}': its tip is {chord:.4} m from its root at t = {t} s, more than 1 % beyond \
-         its length {length} m: the linear frames have stretched, the model is out of its range \
-         (more substructures, or geometric_stiffening for a spinning beam)"
+         its length {length} m: the linear frames have stretched, the model is out of its range"
     )]
     /// A beam's chord (root to tip) is more than 1 % longer than the beam.
     Stretched {
@@ -139,6 +136,16 @@ pub enum EngineError {
         chord: f64,
         /// The beam's length (m).
         length: f64,
+    },
+    #[error("{cause}. {diagnosis}")]
+    /// A failed step with what the unit found of its cause (`unit::engine::diagnosis`): an
+    /// input on a small effective inertia at the communication step in use, a frame spun near
+    /// its first bending frequency, a runaway deflection, or none of them.
+    Diagnosed {
+        /// The failure as the integrator or the validity monitor reported it.
+        cause: Box<EngineError>,
+        /// The causes checked that hold, with their figures and what to change.
+        diagnosis: String,
     },
     #[error("unknown value reference {vr} for a variable of type {ty}")]
     /// No variable of this type has this value reference.
@@ -234,6 +241,9 @@ impl EngineError {
     /// True for failures of a step that the master may retry with a smaller one
     /// (fmi2Discard); all others are errors of use or of input (fmi2Error).
     pub fn is_discard(&self) -> bool {
+        if let EngineError::Diagnosed { cause, .. } = self {
+            return cause.is_discard();
+        }
         matches!(
             self,
             EngineError::NewtonNotConverged { .. }
@@ -254,9 +264,19 @@ impl EngineError {
     /// to end the simulation (fmi2Terminated) instead of inviting a retry.
     pub fn ends_run(&self) -> bool {
         matches!(
-            self,
+            self.cause(),
             EngineError::Runaway { .. } | EngineError::Stretched { .. }
         )
+    }
+}
+
+impl EngineError {
+    /// The failure itself, without the diagnosis a failed step carries.
+    pub fn cause(&self) -> &EngineError {
+        match self {
+            EngineError::Diagnosed { cause, .. } => cause,
+            e => e,
+        }
     }
 }
 

@@ -4,6 +4,7 @@
 mod common;
 use common::{run, scene};
 use fmu_beam::{Engine, EngineError, Scene};
+use std::f64::consts::TAU;
 
 fn with_substructures(file: &str, k: usize) -> Scene {
     let mut s = scene(file);
@@ -120,11 +121,27 @@ fn c4_single_frame_runaway_is_refused_with_a_message() {
     // deflection exceeds the length: either refusal is the model leaving its range
     assert!(
         matches!(
-            err,
+            err.cause(),
             EngineError::Runaway { .. } | EngineError::Stretched { .. }
         ) && err.is_discard()
     );
-    assert!(err.to_string().contains("substructures"));
+    // the diagnosis (issue 32) names the spin near the bending frequency, with its figures
+    // (the chord's mean spin over the last 8 points, 3.7 to 4.4 s: 1.06 rad/s, 0.36 x 2.909
+    // rad/s, between the law's Ω at either end), and no input on a small inertia (none here)
+    let text = err.to_string();
+    assert!(text.contains("Cause found: beam 'beam' spins at"), "{text}");
+    assert!(text.contains("its first bending frequency 2.909"), "{text}");
+    let spin: f64 = text.split("spins at ").nth(1).unwrap()[..5]
+        .parse()
+        .unwrap();
+    let law = |t: f64| 10.0 / 15.0 * (t - 15.0 / TAU * (TAU * t / 15.0).sin());
+    assert!(
+        spin < law(t) && spin > law(t - 0.7),
+        "spin {spin}, law {}",
+        law(t)
+    );
+    assert!(text.contains("geometric_stiffening") && text.contains("substructures"));
+    assert!(!text.contains("effective inertia"), "{text}");
     assert!(warnings
         .iter()
         .any(|w| w.contains("beam 'beam'") && w.contains("substructures")));
@@ -149,10 +166,16 @@ fn c4_coarse_substructures_out_of_range_are_refused() {
     println!("warning: {warnings:?}\nrefused at t = {t:.1} s: {err}");
     assert!(err.is_discard(), "{err}");
     assert!(matches!(
-        err,
+        err.cause(),
         EngineError::Runaway { .. } | EngineError::Stretched { .. }
     ));
-    assert!(err.to_string().contains("substructures"));
+    // the diagnosis (issue 32): the beam's chord spins at 6.80 rad/s over the last 8 points
+    // (the law is still spinning up), 3.30 x its first bending frequency 2.057 rad/s
+    let text = err.to_string();
+    assert!(text.contains("Cause found: beam 'beam' spins at"), "{text}");
+    assert!(text.contains("its first bending frequency 2.057"), "{text}");
+    assert!(!text.contains("effective inertia"), "{text}");
+    assert!(text.contains("substructures"));
     assert!(warnings.iter().any(|w| w.contains("frame 'beam[")));
     assert_eq!(e.time(), t, "the last good state stays");
 }

@@ -7,6 +7,7 @@
 mod common;
 
 mod beam_damping;
+mod input_inertia;
 mod planar_beam_element;
 mod planar_spatial_agreement;
 mod sparse_iteration_matrix;

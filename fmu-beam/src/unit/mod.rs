@@ -6,6 +6,7 @@
 pub(crate) mod axial_load;
 pub(crate) mod effects;
 pub(crate) mod engine;
+pub(crate) mod input_inertia;
 pub(crate) mod interface;
 pub(crate) mod memory;
 pub(crate) mod modes;

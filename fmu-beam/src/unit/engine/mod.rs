@@ -8,6 +8,7 @@
 //! (a parameter value into the scene) and [`validity`] (the small-deformation monitor).
 
 mod assembly;
+mod diagnosis;
 mod model;
 mod outputs;
 mod parameters;
@@ -104,6 +105,13 @@ pub struct Engine {
     messages: Vec<String>,
     /// Whether what assembly moved was logged already (a restored state builds again).
     assembly_reported: bool,
+    /// The effective inertia of each force or torque input, measured when the model was first
+    /// built (`unit::input_inertia`); `None` before.
+    inertias: Option<Vec<crate::unit::input_inertia::InputInertia>>,
+    /// The inputs and their joints' speeds at the last two doStep starts (`diagnosis`).
+    probes: [Option<diagnosis::InputProbe>; 2],
+    /// Each beam's chord at the last communication points, for the spin a diagnosis reads.
+    chords: std::collections::VecDeque<(f64, Vec<nalgebra::Vector3<f64>>)>,
     initialized: bool,
     start_time: f64,
     model: Option<Model>,
@@ -135,6 +143,9 @@ impl Engine {
             split_reported: Vec::new(),
             messages: Vec::new(),
             assembly_reported: false,
+            inertias: None,
+            probes: [None, None],
+            chords: Default::default(),
             scene,
             effects,
             table,
@@ -416,6 +427,21 @@ impl Engine {
                     .extend(assembly::report(&scene, &system, &placed, &state.q));
                 self.assembly_reported = true;
             }
+            if self.inertias.is_none() {
+                let inertias =
+                    crate::unit::input_inertia::input_inertias(&system, &state, &self.table);
+                let h = scene.experiment.step_size;
+                self.messages
+                    .extend(diagnosis::inertia_warnings(&inertias, h));
+                self.inertias = Some(inertias);
+            }
+            // what was recorded past the state restored is not this run's
+            self.chords.retain(|(t, _)| *t <= state.t);
+            for p in &mut self.probes {
+                if p.as_ref().is_some_and(|p| p.t > state.t) {
+                    *p = None;
+                }
+            }
             let (joint_index, body_index) = match &system {
                 Mechanics::Planar(sys) => (
                     scene
@@ -500,6 +526,7 @@ impl Engine {
         // what the master saw at `now`: a failed step gives it back, also where the inputs'
         // change had the integrator land on `now` from past it first
         let saved = self.built()?.save();
+        self.probe_inputs();
         let mut result = self.sync_inputs(now, h);
         let m = self.model.as_mut().expect("built above");
         if result.is_ok() {
@@ -512,12 +539,16 @@ impl Engine {
             self.report_split(saved.stats.split);
         }
         let m = self.model.as_mut().expect("built above");
-        if result.is_err() {
-            m.put_back(saved);
-        } else {
-            m.applied_inputs = crate::unit::interface::inputs_ended(&m.system, m.state.t);
+        match result {
+            Err(e) => {
+                m.put_back(saved);
+                Err(self.diagnose(e, now, h))
+            }
+            Ok(()) => {
+                m.applied_inputs = crate::unit::interface::inputs_ended(&m.system, m.state.t);
+                Ok(())
+            }
         }
-        result
     }
 
     /// Logs the first fixed step of each kind that was cut short (`solver.split_steps` counts
