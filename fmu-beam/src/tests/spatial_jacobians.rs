@@ -282,13 +282,14 @@ fn body_tangents_match_central_differences_of_the_residual() {
     }
 }
 
-/// A beam of `elements` elements (frame kind `frame`) with geometric stiffening on, and a
-/// deformation of slopes up to about `slope` (every kept coordinate random; axial ones 1e-3 of
-/// the element length).
+/// A beam of `elements` elements (frame kind `frame`) with geometric stiffening on, Rayleigh
+/// `beta`, and a deformation of slopes up to about `slope` (every kept coordinate random; axial
+/// ones 1e-3 of the element length).
 fn stiffened_beam(
     frame: FloatingFrame,
     elements: usize,
     slope: f64,
+    beta: f64,
     rng: &mut Random,
 ) -> (crate::mechanics::SpatialBeam, DVector<f64>) {
     use crate::mechanics::beam::spatial_element::{NODE_DOFS, U};
@@ -301,7 +302,7 @@ fn stiffened_beam(
         g: 2.6e10,
         section: SpatialSection::rectangle(0.02, 0.005),
         rayleigh_alpha: 0.0,
-        rayleigh_beta: 0.0,
+        rayleigh_beta: beta,
         inertia: InertiaModel::Full,
     };
     let mut b = crate::mechanics::SpatialBeam::new("s", &props);
@@ -331,7 +332,7 @@ fn stiffened_beam(
 fn stiffening_force_and_tangent_match_central_differences() {
     let mut rng = Random(0x005e_ed0f_571f_f32a);
     for frame in [FloatingFrame::Tangent, FloatingFrame::Pinned] {
-        let (b, f) = stiffened_beam(frame, 3, 0.2, &mut rng);
+        let (b, f) = stiffened_beam(frame, 3, 0.2, 0.0, &mut rng);
         let nf = b.nflex();
         let zero = DVector::zeros(nf);
         let fg = |f: &DVector<f64>| b.internal_force(f, &zero) - &b.kff * f;
@@ -367,13 +368,14 @@ fn stiffening_force_and_tangent_match_central_differences() {
 /// The body tangent's share from stiffening (tangents with it on less tangents with it off,
 /// at one state) against central differences of the residuals' difference: what the
 /// integrator's Newton iteration uses carries the exact K_g (updated column by column in the
-/// beam's products), in both inertia models.
+/// beam's products), in both inertia models; with Rayleigh β, also the strain-rate damping's
+/// ∂f_β/∂q in K_t and ∂f_β/∂q̇ in C_t.
 #[test]
 fn body_tangent_carries_the_stiffening_tangent() {
     use crate::mechanics::multibody3d::Body3;
     let mut rng = Random(0x0dd_ba11_cafe_5eed);
     for model in [InertiaModel::Full, InertiaModel::Frozen] {
-        let (mut beam, f) = stiffened_beam(FloatingFrame::Tangent, 4, 0.1, &mut rng);
+        let (mut beam, f) = stiffened_beam(FloatingFrame::Tangent, 4, 0.1, 2e-3, &mut rng);
         beam.set_inertia(model);
         let on = Body3::Beam(Box::new(beam.clone()));
         beam.set_geometric_stiffening(false);
@@ -396,24 +398,31 @@ fn body_tangent_carries_the_stiffening_tangent() {
                 kt.view_mut((0, 0), (n, n)),
                 ct.view_mut((0, 0), (n, n)),
             );
-            kt
+            (kt, ct)
         };
-        let kt = tangent(&on) - tangent(&off);
-        let r = |z: &DVector<f64>| {
+        let ((kt_on, ct_on), (kt_off, ct_off)) = (tangent(&on), tangent(&off));
+        let (kt, ct) = (kt_on - kt_off, ct_on - ct_off);
+        let r = |z: &DVector<f64>, zd: &DVector<f64>| {
             on.residual(z.rows(0, n), zd.rows(0, n), zdd.rows(0, n), &g)
                 - off.residual(z.rows(0, n), zd.rows(0, n), zdd.rows(0, n), &g)
         };
-        let mut kd = DMatrix::zeros(n, n);
+        let (mut kd, mut cd) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
         for k in 0..n {
             let h = 1e-6 * z[k].abs().max(1e-2);
             let (mut zp, mut zm) = (z.clone(), z.clone());
             zp[k] += h;
             zm[k] -= h;
-            kd.set_column(k, &((r(&zp) - r(&zm)) / (2.0 * h)));
+            kd.set_column(k, &((r(&zp, &zd) - r(&zm, &zd)) / (2.0 * h)));
+            let h = 1e-3;
+            let (mut vp, mut vm) = (zd.clone(), zd.clone());
+            vp[k] += h;
+            vm[k] -= h;
+            cd.set_column(k, &((r(&z, &vp) - r(&z, &vm)) / (2.0 * h)));
         }
-        let err = relative(&kt, &kd);
-        println!("{model:?}: K_g in the body tangent {err:.1e}");
+        let (err, err_c) = (relative(&kt, &kd), relative(&ct, &cd));
+        println!("{model:?}: K_g in the body tangent {err:.1e}, the β part of C_t {err_c:.1e}");
         assert!(err < 1e-6, "{model:?}: {err:.2e}");
-        assert!(kd.amax() > 0.0);
+        assert!(err_c < 1e-6, "{model:?}: C_t {err_c:.2e}");
+        assert!(kd.amax() > 0.0 && cd.amax() > 0.0);
     }
 }

@@ -358,6 +358,9 @@ impl PlanarBeam {
         }
         if self.geometric_stiffening {
             self.stiffening_force(&z, &mut r[FLEX..FLEX + nf]);
+            if damping && self.rayleigh_beta != 0.0 {
+                self.stiffening_damping(&z, &zd, &mut r[FLEX..FLEX + nf]);
+            }
         }
     }
 
@@ -478,6 +481,9 @@ impl PlanarBeam {
         }
         if self.geometric_stiffening {
             self.stiffening_tangent(&z, &mut kt);
+            if damping && self.rayleigh_beta != 0.0 {
+                self.stiffening_damping_tangents(&z, &zd, &mut kt, &mut ct);
+            }
         }
     }
 

@@ -486,7 +486,7 @@ impl SpatialBeam {
             dfd: &self.dff * fd,
             mfdd: &self.mff * fdd,
             skew_fd,
-            stiffening: self.stiffening(&f),
+            stiffening: self.stiffening(&f, &fd),
         }
     }
 
@@ -512,6 +512,9 @@ impl SpatialBeam {
     /// Updates `pr` for q̇_f moved by `h` in coordinate `k`.
     pub fn shift_flex_rate(&self, pr: &mut BeamProducts, k: usize, h: f64) {
         pr.dfd.axpy(h, &self.dff.column(k), 1.0);
+        if let Some(st) = pr.stiffening.as_mut() {
+            self.shift_stiffening_rate(st, k, h);
+        }
         if let Some(s) = self.full() {
             for (j, sk) in pr.skew_fd.iter_mut().enumerate() {
                 let m = &s.mij[j + 3];
@@ -644,7 +647,7 @@ impl SpatialBeam {
         q
     }
 
-    /// Internal force K_ff q_f + f_g + D_ff q̇_f on the deformation rows.
+    /// Internal force K_ff q_f + f_g + D_ff q̇_f (+ f_β with stiffening) on the deformation rows.
     pub fn internal_force<'a>(
         &self,
         f: impl Into<DVectorView<'a, f64>>,
@@ -652,7 +655,7 @@ impl SpatialBeam {
     ) -> DVector<f64> {
         let (f, fd) = (f.into(), fd.into());
         let linear = &self.kff * f + &self.dff * fd;
-        match self.stiffening(&f) {
+        match self.stiffening(&f, &fd) {
             Some(st) => linear + st.force(),
             None => linear,
         }

@@ -17,6 +17,13 @@
 //! the exact gradient and Hessian of U_g. The axial force N = EA ε couples with the transverse
 //! slopes of both planes: tension (a spinning blade's centrifugal load) stiffens bending in y
 //! and z alike. Torsion does not enter (no Wagner term), as in the planar beam.
+//!
+//! With Rayleigh β, β acts on the strain rate ε̇ = ∂ε · q̇ rather than on u̇' alone, as in the
+//! planar beam (`planar_beam/stiffening.rs` says why: β EA u̇' held the axis from shortening as
+//! the beam bends, and the spurious tension stiffened it): the force added to β K_ff q̇_f is
+//!
+//!   f_β = Σ_e β EA ℓ (ε̇ ∂ε − u̇' ∂u'),
+//!   ∂f_β/∂q̇ = Σ_e β EA ℓ (∂ε ∂εᵀ − ∂u' ∂u'ᵀ),   ∂f_β/∂q = Σ_e β EA ℓ (∂ε (H q̇)ᵀ + ε̇ H).
 
 use super::*;
 
@@ -69,12 +76,16 @@ impl StrainRows {
     }
 }
 
-/// One element's strain at a state: u', ε and ∂ε/∂q_e.
+/// One element's strain at a state: u', ε and ∂ε/∂q_e; and with β damping, its rates u̇', ε̇
+/// and H q̇_e.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct ElementStrain {
     du: f64,
     eps: f64,
     de: Row,
+    du_dot: f64,
+    eps_dot: f64,
+    h_qd: Row,
 }
 
 /// The stiffening force f_g at a state and each element's strain there (from which any column
@@ -102,13 +113,14 @@ impl SpatialBeam {
         self.geometric_stiffening = on;
     }
 
-    /// Each element's strain at q_f.
-    fn element_strains(&self, f: &DVectorView<f64>) -> Vec<ElementStrain> {
+    /// Each element's strain at q_f, and its rates at q̇_f.
+    fn element_strains(&self, f: &DVectorView<f64>, fd: &DVectorView<f64>) -> Vec<ElementStrain> {
         let rows = &self.strain;
         rows.index
             .iter()
             .map(|idx| {
                 let qe: Row = std::array::from_fn(|p| idx[p].map_or(0.0, |k| f[k]));
+                let qd: Row = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fd[k]));
                 let du: f64 = (0..ELEMENT_DOFS).map(|p| rows.du[p] * qe[p]).sum();
                 let (mut eps, mut de) = (du, rows.du);
                 for (pair, &(_, w)) in rows.slopes.iter().zip(&GAUSS_4) {
@@ -120,23 +132,39 @@ impl SpatialBeam {
                         }
                     }
                 }
-                ElementStrain { du, eps, de }
+                ElementStrain {
+                    du,
+                    eps,
+                    de,
+                    du_dot: (0..ELEMENT_DOFS).map(|p| rows.du[p] * qd[p]).sum(),
+                    eps_dot: (0..ELEMENT_DOFS).map(|p| de[p] * qd[p]).sum(),
+                    h_qd: std::array::from_fn(|p| {
+                        (0..ELEMENT_DOFS).map(|r| rows.h[p][r] * qd[r]).sum()
+                    }),
+                }
             })
             .collect()
     }
 
-    /// f_g and the element strains at q_f, if stiffening is on.
-    pub(super) fn stiffening(&self, f: &DVectorView<f64>) -> Option<Stiffening> {
+    /// f_g (and f_β, with β damping) and the element strains at q_f, q̇_f, if stiffening is on.
+    pub(super) fn stiffening(
+        &self,
+        f: &DVectorView<f64>,
+        fd: &DVectorView<f64>,
+    ) -> Option<Stiffening> {
         if !self.geometric_stiffening {
             return None;
         }
-        let elements = self.element_strains(f);
+        let elements = self.element_strains(f, fd);
         let mut force = DVector::zeros(self.nflex());
         let (ea_l, du) = (self.ea * self.strain.l, &self.strain.du);
+        let beta = self.rayleigh_beta;
         for (idx, e) in self.strain.index.iter().zip(&elements) {
             for p in 0..ELEMENT_DOFS {
                 if let Some(k) = idx[p] {
-                    force[k] += ea_l * (e.eps * e.de[p] - e.du * du[p]);
+                    force[k] += ea_l
+                        * (e.eps * e.de[p] - e.du * du[p]
+                            + beta * (e.eps_dot * e.de[p] - e.du_dot * du[p]));
                 }
             }
         }
@@ -155,21 +183,48 @@ impl SpatialBeam {
                 continue;
             }
             let e = st.elements[j];
+            let beta = self.rayleigh_beta;
             for (r, idx) in rows.index[j].iter().enumerate() {
                 if let Some(kr) = idx {
-                    let g = e.de[p] * e.de[r] + e.eps * rows.h[p][r] - rows.du[p] * rows.du[r];
+                    let g = e.de[p] * e.de[r] + e.eps * rows.h[p][r] - rows.du[p] * rows.du[r]
+                        + beta * (e.h_qd[p] * e.de[r] + e.eps_dot * rows.h[p][r]);
                     st.force[*kr] += h * ea_l * g;
                 }
             }
         }
     }
 
-    /// K_g = ∂f_g/∂q_f at q_f (nf × nf; zero when stiffening is off).
+    /// Adds h × column `k` of ∂f_β/∂q̇_f to the force: the tangent column of a move of q̇_f by
+    /// h in coordinate k (nothing without β damping).
+    pub(super) fn shift_stiffening_rate(&self, st: &mut Stiffening, k: usize, h: f64) {
+        if self.rayleigh_beta == 0.0 {
+            return;
+        }
+        let node = self.kept[k] / NODE_DOFS;
+        let rows = &self.strain;
+        let c = self.rayleigh_beta * self.ea * rows.l;
+        for j in node.saturating_sub(1)..node.min(self.elements - 1) + 1 {
+            let p = self.kept[k] - NODE_DOFS * j;
+            if p >= ELEMENT_DOFS {
+                continue;
+            }
+            let e = st.elements[j];
+            for (r, idx) in rows.index[j].iter().enumerate() {
+                if let Some(kr) = idx {
+                    let g = e.de[p] * e.de[r] - rows.du[p] * rows.du[r];
+                    st.force[*kr] += h * c * g;
+                }
+            }
+        }
+    }
+
+    /// K_g = ∂f_g/∂q_f at q_f, at rest (nf × nf; zero when stiffening is off).
     pub fn stiffening_tangent<'a>(&self, f: impl Into<DVectorView<'a, f64>>) -> DMatrix<f64> {
         let f = f.into();
         let nf = self.nflex();
         let mut kg = DMatrix::zeros(nf, nf);
-        if let Some(mut st) = self.stiffening(&f) {
+        let rest = DVector::zeros(nf);
+        if let Some(mut st) = self.stiffening(&f, &rest.as_view()) {
             for k in 0..nf {
                 st.force.fill(0.0);
                 self.shift_stiffening(&mut st, k, 1.0);
@@ -185,7 +240,8 @@ impl SpatialBeam {
             return 0.0;
         }
         let ea_l = self.ea * self.strain.l;
-        self.element_strains(f)
+        let rest = DVector::zeros(self.nflex());
+        self.element_strains(f, &rest.as_view())
             .iter()
             .map(|e| 0.5 * ea_l * (e.eps * e.eps - e.du * e.du))
             .sum()

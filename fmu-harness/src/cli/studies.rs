@@ -1,0 +1,163 @@
+//! The study commands of the command line: `modes` (with `--campbell`) and `accuracy`, and the
+//! latter's options.
+
+use super::stdout_err;
+use crate::error::HarnessError;
+use crate::{accuracy, modes};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The options of `accuracy`.
+#[derive(Debug, clap::Args)]
+pub struct AccuracyArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// An output to study (repeat for several; the error is the largest of theirs).
+    #[arg(long = "output", required = true)]
+    pub outputs: Vec<String>,
+    /// The error to meet: max over the grid of |y − y*| / max |y*|.
+    #[arg(long, allow_hyphen_values = true)]
+    pub target: f64,
+    /// Stop time [default: the scene's experiment].
+    #[arg(long, allow_hyphen_values = true)]
+    pub stop: Option<f64>,
+    /// The grid the outputs are compared on [default: the experiment's step_size].
+    #[arg(long, allow_hyphen_values = true)]
+    pub comm: Option<f64>,
+    /// The time ladder's coarsest fixed step [default: the larger of the communication step
+    /// and the scene's max_step].
+    #[arg(long, allow_hyphen_values = true)]
+    pub step: Option<f64>,
+    /// Newton's tolerance at the coarsest step, divided by 4 at each halving [default: the
+    /// smaller of the scene's tolerance and target / 10].
+    #[arg(long, allow_hyphen_values = true)]
+    pub newton: Option<f64>,
+    /// Steps in the time ladder (each half the one before).
+    #[arg(long, default_value_t = 5)]
+    pub levels: usize,
+    /// Meshes in the mesh ladder: the scene's, then each flexible beam's elements (or
+    /// substructures) doubled.
+    #[arg(long, default_value_t = 3)]
+    pub mesh_levels: usize,
+    /// The study's budget: runs.
+    #[arg(long, default_value_t = 30)]
+    pub max_runs: usize,
+    /// The study's budget: wall seconds (a run predicted to pass it is left out and said).
+    #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+    pub max_seconds: f64,
+    /// A reference CSV (time first, on the study's grid; e.g. bench/reference/c4_omega10.csv):
+    /// each run's true error is reported beside its estimate.
+    #[arg(long, requires = "columns")]
+    pub reference: Option<PathBuf>,
+    /// The reference's column for each --output, in the same order.
+    #[arg(long = "column", requires = "reference")]
+    pub columns: Vec<String>,
+    /// The folder for accuracy.csv and accuracy.png [default: build/accuracy/<scene name>].
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+}
+
+/// `modes`: what was linearized, then the first `count` natural frequencies.
+pub(super) fn modes_cmd(
+    scene_path: &Path,
+    count: usize,
+    options: &fmu_beam::ModeOptions,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let scene = fmu_beam::Scene::load(scene_path)?;
+    let m = modes::modes_of(&scene, &scene_path.display().to_string(), options)?;
+    out.write_all(modes::full_report(&m, count).as_bytes())
+        .map_err(stdout_err)
+}
+
+/// `accuracy`: runs the study, writes its CSV and PNG, prints the Markdown report.
+pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<(), HarnessError> {
+    let mut o = accuracy::Options::new(args.outputs, args.target);
+    o.stop = args.stop;
+    o.comm = args.comm;
+    o.step = args.step;
+    o.newton = args.newton;
+    o.levels = args.levels;
+    o.mesh_levels = args.mesh_levels;
+    o.max_runs = args.max_runs;
+    o.max_seconds = args.max_seconds;
+    o.reference = args.reference.map(|p| (p, args.columns));
+    o.progress = true;
+    let study = accuracy::study(&args.scene, &o)?;
+    let dir = args
+        .dir
+        .unwrap_or_else(|| Path::new("build/accuracy").join(&study.scene));
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| HarnessError::io(&dir, "creating the study's folder", e))?;
+    let csv = dir.join("accuracy.csv");
+    std::fs::write(&csv, accuracy::report::csv(&study))
+        .map_err(|e| HarnessError::io(&csv, "writing the table", e))?;
+    let png = dir.join("accuracy.png");
+    std::fs::write(&png, accuracy::plot::png(&study))
+        .map_err(|e| HarnessError::io(&png, "writing the chart", e))?;
+    write!(
+        out,
+        "{}\nWrote {} and {}.\n",
+        accuracy::report::markdown(&study),
+        csv.display(),
+        png.display()
+    )
+    .map_err(stdout_err)
+}
+
+/// `modes --campbell`: the first `count` frequencies at each speed, as CSV and PNG.
+pub(super) fn campbell_cmd(
+    scene_path: &Path,
+    count: usize,
+    options: fmu_beam::ModeOptions,
+    spec: &str,
+    output: Option<PathBuf>,
+    out: &mut dyn Write,
+) -> Result<(), HarnessError> {
+    let speeds = modes::campbell::parse_speeds(spec)?;
+    let scene = fmu_beam::Scene::load(scene_path)?;
+    let origin = scene_path.display().to_string();
+    let mut frequencies = Vec::with_capacity(speeds.len());
+    let mut last = None;
+    for &speed in &speeds {
+        let o = fmu_beam::ModeOptions {
+            speed,
+            ..options.clone()
+        };
+        let m = modes::modes_of(&scene, &origin, &o)?;
+        frequencies.push(m.frequencies.iter().copied().take(count).collect());
+        last = Some(m);
+    }
+    let d = modes::campbell::Diagram {
+        speeds,
+        frequencies,
+    };
+    let prefix = output.unwrap_or_else(|| PathBuf::from(format!("{}_campbell", scene.name)));
+    let with = |ext: &str| {
+        let mut p = prefix.clone().into_os_string();
+        p.push(ext);
+        PathBuf::from(p)
+    };
+    let (csv, png) = (with(".csv"), with(".png"));
+    crate::archive::write_atomically(&csv, d.csv().as_bytes())?;
+    let title = format!("{}: Campbell diagram", scene.name);
+    crate::archive::write_atomically(&png, &d.png(&title, 800, 560))?;
+    let m = last.expect("at least two speeds");
+    let text = format!(
+        "Campbell diagram of {} modes at {} speeds from {} to {} rad/s (hub '{}'; joints \
+         locked: {}): wrote {} and {}\n",
+        d.modes(),
+        d.speeds.len(),
+        d.speeds[0],
+        d.speeds[d.speeds.len() - 1],
+        m.hub.as_deref().unwrap_or("?"),
+        if m.locked.is_empty() {
+            "none".to_string()
+        } else {
+            m.locked.join(", ")
+        },
+        csv.display(),
+        png.display()
+    );
+    out.write_all(text.as_bytes()).map_err(stdout_err)
+}
