@@ -51,25 +51,60 @@ fn rigid_scene(scene: &Scene) -> (Scene, Effects, Settings) {
     (rigid, effects, settings)
 }
 
-/// The axial load of each scene beam (in scene order), or why the run failed.
-pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
-    let (rigid, effects, settings) = rigid_scene(scene);
-    let sys = System::build(&rigid, &effects);
+/// Runs `sys` (the rigid scene of `scene`) over the experiment and calls `visit` at each of the
+/// [`SAMPLES`] times with the state, the time and the constraint Jacobian there.
+fn sample<S: Equations>(
+    sys: &S,
+    scene: &Scene,
+    settings: Settings,
+    mut visit: impl FnMut(&crate::integrator::GaState, f64, &DMatrix<f64>),
+) -> Result<(), String> {
     let t0 = scene.experiment.start_time;
     let dt = settings.max_step;
-    let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
-    let mut stepper = Stepper::new(&sys, settings);
+    let mut st = initial_state(sys, t0, &settings).map_err(|e| e.to_string())?;
+    let mut stepper = Stepper::new(sys, settings);
     let mut stats = Stats::default();
     let mut gm = DMatrix::zeros(sys.m(), sys.n());
-    let mut loads = vec![AxialLoad { force: 0.0, at: t0 }; scene.beams.len()];
     for k in 0..=SAMPLES {
         let t = t0 + k as f64 * dt;
         if k > 0 {
             stepper
-                .step_to(&sys, &mut st, &mut stats, t)
+                .step_to(sys, &mut st, &mut stats, t)
                 .map_err(|e| e.to_string())?;
         }
         sys.constraint_jacobian(&st.q, t, &mut gm);
+        visit(&st, t, &gm);
+    }
+    Ok(())
+}
+
+/// Keeps in `load` the largest of the axial components (along `axis`) of `forces`, at `t`.
+fn keep_largest<V>(
+    load: &mut AxialLoad,
+    forces: impl Iterator<Item = V>,
+    axial: impl Fn(&V) -> f64,
+    t: f64,
+) {
+    for f in forces {
+        let a = axial(&f).abs();
+        if a > load.force {
+            *load = AxialLoad { force: a, at: t };
+        }
+    }
+}
+
+/// The axial load of each scene beam (in scene order), or why the run failed.
+pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
+    let (rigid, effects, settings) = rigid_scene(scene);
+    let sys = System::build(&rigid, &effects);
+    let mut loads = vec![
+        AxialLoad {
+            force: 0.0,
+            at: scene.experiment.start_time
+        };
+        scene.beams.len()
+    ];
+    sample(&sys, scene, settings, |st, t, gm| {
         for (g, load) in loads.iter_mut().enumerate() {
             let body = sys.beams[g].bodies.start;
             let o = sys.offsets[body];
@@ -86,17 +121,9 @@ pub fn rigid_run(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
                 .iter()
                 .filter(|l| sys.frame_body(l.frame) == Some(body))
                 .map(|l| sys.load_value(l, t).0);
-            for f in joints.chain(external) {
-                let axial = f.dot(&axis).abs();
-                if axial > load.force {
-                    *load = AxialLoad {
-                        force: axial,
-                        at: t,
-                    };
-                }
-            }
+            keep_largest(load, joints.chain(external), |f| f.dot(&axis), t);
         }
-    }
+    })?;
     Ok(loads)
 }
 
@@ -106,21 +133,14 @@ pub fn rigid_run_3d(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
     let Mechanics::Spatial(sys, index) = Mechanics::build(&rigid, &effects) else {
         return Err("the scene runs with the planar element".into());
     };
-    let t0 = scene.experiment.start_time;
-    let dt = settings.max_step;
-    let mut st = initial_state(&sys, t0, &settings).map_err(|e| e.to_string())?;
-    let mut stepper = Stepper::new(&sys, settings);
-    let mut stats = Stats::default();
-    let mut gm = DMatrix::zeros(sys.m(), sys.n());
-    let mut loads = vec![AxialLoad { force: 0.0, at: t0 }; scene.beams.len()];
-    for k in 0..=SAMPLES {
-        let t = t0 + k as f64 * dt;
-        if k > 0 {
-            stepper
-                .step_to(&sys, &mut st, &mut stats, t)
-                .map_err(|e| e.to_string())?;
-        }
-        sys.constraint_jacobian(&st.q, t, &mut gm);
+    let mut loads = vec![
+        AxialLoad {
+            force: 0.0,
+            at: scene.experiment.start_time
+        };
+        scene.beams.len()
+    ];
+    sample(&sys, scene, settings, |st, t, gm| {
         for (load, bodies) in loads.iter_mut().zip(&index.beam_bodies) {
             let (body, o) = (bodies.start, sys.offsets[bodies.start]);
             let (_, _, a) =
@@ -138,16 +158,8 @@ pub fn rigid_run_3d(scene: &Scene) -> Result<Vec<AxialLoad>, String> {
                 .iter()
                 .filter(|l| sys.frames[l.frame].body() == Some(body))
                 .map(|l| l.force * sys.load_scale(l, t));
-            for f in joints.chain(external) {
-                let axial = f.dot(&axis).abs();
-                if axial > load.force {
-                    *load = AxialLoad {
-                        force: axial,
-                        at: t,
-                    };
-                }
-            }
+            keep_largest(load, joints.chain(external), |f| f.dot(&axis), t);
         }
-    }
+    })?;
     Ok(loads)
 }
