@@ -42,6 +42,9 @@ pub fn full_report(m: &Modes, count: usize) -> String {
         )
         }
         Some(h) => s += &format!("linearized at rest, hub '{h}' held\n"),
+        None if m.equilibrium => {
+            s += "linearized at rest about the static equilibrium under gravity and the loads\n"
+        }
         None => s += "linearized at rest about the initial placement\n",
     }
     if m.locked.is_empty() {

@@ -3,7 +3,9 @@
 //! its centrifugal load), as M x'' + C x' + K x = 0 on the motions the joints leave free.
 //!
 //! At rest the state is the scene's undeformed placement (its multipliers from the consistent
-//! start, so a hanging pendulum feels gravity). At speed Ω the steady state is solved in the
+//! start, so a hanging pendulum feels gravity), or with `equilibrium` the static equilibrium
+//! under gravity and the loads at t = 0 (a tensioned or sagging beam, its geometric stiffening
+//! from the axial strain it takes). At speed Ω the steady state is solved in the
 //! co-rotating frame (`linearize::steady_state`), and the systems' invariance to turning about
 //! world z makes the perturbation equations constant in that frame (`linearize::corotating`): the
 //! gyroscopic matrix 2ΩMJ and the centrifugal terms come out of the system's own residual.
@@ -31,6 +33,9 @@ pub struct ModeOptions {
     /// The hub joint (a revolute joint to `world`); by default the one revolute joint to
     /// `world` with a motion drive.
     pub hub: Option<String>,
+    /// At rest: linearize about the static equilibrium under gravity and the loads at t = 0
+    /// (the deformed state, its axial forces included), not the undeformed placement.
+    pub equilibrium: bool,
 }
 
 /// One oscillating mode of the damped system.
@@ -64,6 +69,8 @@ pub struct Modes {
     pub hub: Option<String>,
     /// Hub speed (rad/s).
     pub speed: f64,
+    /// Linearized at rest about the static equilibrium ([`ModeOptions::equilibrium`]).
+    pub equilibrium: bool,
 }
 
 /// Natural frequencies (Hz), ascending, of the scene linearized about its initial
@@ -111,10 +118,10 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         b.rayleigh.beta = 0.0;
     }
     crate::unit::memory::ensure_available(&scene, "natural frequencies")?;
-    let undamped = linear_model(&scene, options.speed)?;
+    let undamped = linear_model(&scene, options)?;
     let solved = eigen::solve(&undamped, spinning)?;
     let damped = if has_damping {
-        let lin = linear_model(&damped_scene, options.speed)?;
+        let lin = linear_model(&damped_scene, options)?;
         eigen::solve(&lin, true)?.damped
     } else {
         Vec::new()
@@ -137,17 +144,24 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
             .collect(),
         hub,
         speed: options.speed,
+        equilibrium: options.equilibrium && !spinning,
     })
 }
 
-/// The scene's system linearized at rest (its start) or at the steady state at `speed`.
-fn linear_model(scene: &Scene, speed: f64) -> Result<linearize::Linear, EngineError> {
+/// The scene's system linearized at rest (its start, or its static equilibrium) or at the
+/// steady state at the options' speed.
+fn linear_model(scene: &Scene, options: &ModeOptions) -> Result<linearize::Linear, EngineError> {
+    let speed = options.speed;
     let settings = Settings::from_scene(scene);
     let effects = crate::unit::effects::resolve(scene).effects;
     let sys = Mechanics::build(scene, &effects);
     let st = initial_state(&sys, 0.0, &settings)?;
     let spin = linearize::Spin::of(&sys);
     if speed == 0.0 {
+        if options.equilibrium {
+            let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, 0.0)?;
+            return linearize::corotating(&sys, &spin, &q, &lambda, 0.0);
+        }
         return linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0);
     }
     let (gravity, loads) = match &sys {

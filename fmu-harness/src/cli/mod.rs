@@ -69,6 +69,10 @@ pub enum Command {
         /// joint with a motion drive].
         #[arg(long, value_name = "JOINT")]
         hub: Option<String>,
+        /// At rest: linearize about the static equilibrium under gravity and the loads at the
+        /// start (a tensioned or sagging beam), not the undeformed placement.
+        #[arg(long, conflicts_with_all = ["speed", "campbell"])]
+        equilibrium: bool,
         /// Campbell diagram over hub speeds `START:STOP:COUNT` (rad/s), e.g. 0:10:21: writes
         /// PREFIX.csv and PREFIX.png.
         #[arg(long, value_name = "START:STOP:COUNT")]
@@ -180,6 +184,7 @@ pub fn run_with_engines(
             lock_all,
             speed,
             hub,
+            equilibrium,
             campbell,
             output,
         } => {
@@ -188,6 +193,7 @@ pub fn run_with_engines(
                 lock_all,
                 speed,
                 hub,
+                equilibrium,
             };
             match campbell {
                 Some(spec) => campbell_cmd(&scene, count, options, &spec, output, out),
