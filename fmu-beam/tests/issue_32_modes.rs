@@ -295,7 +295,7 @@ fn rotating_cantilever_3d_flap_follows_southwell_in_one_stiffened_frame() {
 fn flap_k(scene: &Scene, speeds: &[f64], what: &str) -> f64 {
     let at = |w: f64| {
         modes(
-            &scene,
+            scene,
             &ModeOptions {
                 speed: w,
                 ..ModeOptions::default()
