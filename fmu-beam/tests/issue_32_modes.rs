@@ -407,6 +407,14 @@ fn a_tensioned_beam_linearized_about_its_equilibrium() {
         strained.frequencies[0]
     );
     assert!(strained.equilibrium && !free.equilibrium);
+    // the placement says when it is no equilibrium (under T), and is quiet when it is
+    let placed = modes(&scene(tension), &ModeOptions::default()).unwrap();
+    assert!(
+        placed.off_equilibrium.is_some_and(|a| a > 1.0),
+        "{placed:?}"
+    );
+    assert_eq!(free.off_equilibrium, None);
+    assert_eq!(strained.off_equilibrium, None);
     assert!(
         rel(strained.frequencies[0], exact) < 1e-3,
         "{} against {exact}",

@@ -47,6 +47,14 @@ pub fn full_report(m: &Modes, count: usize) -> String {
         }
         None => s += "linearized at rest about the initial placement\n",
     }
+    if let Some(a) = m.off_equilibrium {
+        s += &format!(
+            "the placement is not an equilibrium under gravity and the loads (it starts with \
+             accelerations up to {}): these are the modes about a state the scene leaves at \
+             once; --equilibrium linearizes about its deformed equilibrium\n",
+            significant(a, 3)
+        );
+    }
     if m.locked.is_empty() {
         s += "joints locked: none\n";
     } else {

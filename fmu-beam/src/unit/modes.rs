@@ -71,6 +71,11 @@ pub struct Modes {
     pub speed: f64,
     /// Linearized at rest about the static equilibrium ([`ModeOptions::equilibrium`]).
     pub equilibrium: bool,
+    /// At rest about the placement: the largest acceleration (of any coordinate) the scene
+    /// starts with there, where it is not at rest under gravity and its loads (above 1e-6):
+    /// then the placement is no equilibrium, and `equilibrium` linearizes about the deformed
+    /// state instead.
+    pub off_equilibrium: Option<f64>,
 }
 
 /// Natural frequencies (Hz), ascending, of the scene linearized about its initial
@@ -118,10 +123,10 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         b.rayleigh.beta = 0.0;
     }
     crate::unit::memory::ensure_available(&scene, "natural frequencies")?;
-    let undamped = linear_model(&scene, options)?;
+    let (undamped, placed_acceleration) = linear_model(&scene, options)?;
     let solved = eigen::solve(&undamped, spinning)?;
     let damped = if has_damping {
-        let lin = linear_model(&damped_scene, options)?;
+        let (lin, _) = linear_model(&damped_scene, options)?;
         eigen::solve(&lin, true)?.damped
     } else {
         Vec::new()
@@ -145,12 +150,26 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         hub,
         speed: options.speed,
         equilibrium: options.equilibrium && !spinning,
+        off_equilibrium: (!spinning && !options.equilibrium && placed_acceleration > 1e-6)
+            .then_some(placed_acceleration),
     })
 }
 
 /// The scene's system linearized at rest (its start, or its static equilibrium) or at the
-/// steady state at the options' speed.
-fn linear_model(scene: &Scene, options: &ModeOptions) -> Result<linearize::Linear, EngineError> {
+/// steady state at the options' speed; and the largest acceleration of the consistent start.
+fn linear_model(
+    scene: &Scene,
+    options: &ModeOptions,
+) -> Result<(linearize::Linear, f64), EngineError> {
+    let (lin, st) = linear_model_at(scene, options)?;
+    Ok((lin, st.qdd.amax()))
+}
+
+/// [`linear_model`], with the consistent start it began from.
+fn linear_model_at(
+    scene: &Scene,
+    options: &ModeOptions,
+) -> Result<(linearize::Linear, crate::integrator::GaState), EngineError> {
     let speed = options.speed;
     let settings = Settings::from_scene(scene);
     let effects = crate::unit::effects::resolve(scene).effects;
@@ -158,11 +177,13 @@ fn linear_model(scene: &Scene, options: &ModeOptions) -> Result<linearize::Linea
     let st = initial_state(&sys, 0.0, &settings)?;
     let spin = linearize::Spin::of(&sys);
     if speed == 0.0 {
-        if options.equilibrium {
+        let lin = if options.equilibrium {
             let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, 0.0)?;
-            return linearize::corotating(&sys, &spin, &q, &lambda, 0.0);
-        }
-        return linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0);
+            linearize::corotating(&sys, &spin, &q, &lambda, 0.0)?
+        } else {
+            linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0)?
+        };
+        return Ok((lin, st));
     }
     let (gravity, loads) = match &sys {
         Mechanics::Planar(s) => (
@@ -184,7 +205,7 @@ fn linear_model(scene: &Scene, options: &ModeOptions) -> Result<linearize::Linea
         ));
     }
     let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, speed)?;
-    linearize::corotating(&sys, &spin, &q, &lambda, speed)
+    Ok((linearize::corotating(&sys, &spin, &q, &lambda, speed)?, st))
 }
 
 /// The hub joint at speed: the one named, else the one revolute joint to `world` with a motion
