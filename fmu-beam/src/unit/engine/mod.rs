@@ -252,8 +252,10 @@ impl Engine {
         let jump = loads_changed
             || (changed
                 && crate::unit::interface::inputs_jump(&m.applied_inputs, &applied, &m.system));
-        // the loads the last step had, until the jump is met
-        tunable_loads::write_loads(&mut m.system, &self.load_parts, &m.applied_loads);
+        // the loads the last step had, until the jump is met (set_real wrote the new ones in)
+        if loads_changed {
+            tunable_loads::write_loads(&mut m.system, &self.load_parts, &m.applied_loads);
+        }
         if jump || (changed && m.is_past(t0)) {
             // the inputs as the last step ended them (set_real wrote the new ones in already)
             let ended = if m.applied_inputs.len() == 3 * m.system.inputs().len() {
@@ -274,9 +276,11 @@ impl Engine {
                 tunable_loads::write_loads(sys, parts, &loads)
             })?;
         }
-        tunable_loads::write_loads(&mut m.system, &self.load_parts, &loads);
+        if loads_changed {
+            // met above (a change of the loads is a jump)
+            m.applied_loads = loads;
+        }
         m.applied_inputs = applied;
-        m.applied_loads = loads;
         Ok(())
     }
 
