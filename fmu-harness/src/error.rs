@@ -61,6 +61,9 @@ pub enum HarnessError {
         variable: String,
         unit: String,
     },
+    #[error("scene `{scene}`: {message}")]
+    /// The scene's `[accuracy]` names no Real output of the unit (a refused scene: exit 2).
+    AccuracyStatement { scene: String, message: String },
     #[error("scene `{scene}`: its canonical text for resources/scene.toml is unusable: {message}")]
     CanonicalScene { scene: String, message: String },
     #[error(transparent)]
@@ -139,7 +142,7 @@ impl HarnessError {
     /// anything else.
     pub fn exit_code(&self) -> i32 {
         match self {
-            HarnessError::Scene(_) => 2,
+            HarnessError::Scene(_) | HarnessError::AccuracyStatement { .. } => 2,
             HarnessError::Ended(_) | HarnessError::CosimEnded(_) => 3,
             _ => 1,
         }

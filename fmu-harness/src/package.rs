@@ -104,7 +104,7 @@ pub fn contents(
         guid,
         model_description,
         scene_text,
-        documentation: documentation(scene, &table),
+        documentation: documentation(scene, &table)?,
         variables: table.variables.len(),
     })
 }
@@ -112,13 +112,24 @@ pub fn contents(
 /// documentation/index.html: the scene's description, its variables (the table that
 /// modelDescription.xml is written from: name, causality, variability, type, unit, start,
 /// meaning; inputs first, then outputs, then parameters), its resolved effects and its direct
-/// feedthrough (`fmu_beam::explain_feedthrough`).
-fn documentation(scene: &Scene, table: &VariableTable) -> String {
+/// feedthrough (`fmu_beam::explain_feedthrough`); first, the accuracy the scene was tuned for
+/// (`fmu_beam::explain_accuracy`), refused if its output is not one of the unit's.
+fn documentation(scene: &Scene, table: &VariableTable) -> Result<String, HarnessError> {
     let effects = fmu_beam::resolve_effects(scene).explain(scene);
     let feedthrough = fmu_beam::explain_feedthrough(scene, table);
-    format!(
+    let accuracy = match fmu_beam::explain_accuracy(scene, table) {
+        Ok(text) if text.is_empty() => String::new(),
+        Ok(text) => format!("<p>{}</p>\n", escape(&text)),
+        Err(message) => {
+            return Err(HarnessError::AccuracyStatement {
+                scene: scene.name.clone(),
+                message,
+            })
+        }
+    };
+    Ok(format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\n{STYLE}</head>\n\
-         <body>\n<h1>{name}</h1>\n<p>{description}</p>\n<h2>Variables</h2>\n{variables}\
+         <body>\n<h1>{name}</h1>\n<p>{description}</p>\n{accuracy}<h2>Variables</h2>\n{variables}\
          <h2>Effects</h2>\n<pre>\n{effects}</pre>\n\
          <h2>Direct feedthrough and directional derivatives</h2>\n<pre>\n{feedthrough}</pre>\n\
          </body></html>\n",
@@ -127,7 +138,7 @@ fn documentation(scene: &Scene, table: &VariableTable) -> String {
         variables = variables_html(table),
         effects = escape(&effects),
         feedthrough = escape(&feedthrough),
-    )
+    ))
 }
 
 const STYLE: &str = "<style>table{border-collapse:collapse}td,th{border:1px solid #ccc;\

@@ -1,5 +1,6 @@
-//! `fmu-harness explain`: each resolved effect with its setting, reason and cost share; the
-//! same text is the FMU's documentation; a wrong `effects` is refused naming the field.
+//! `fmu-harness explain`: the accuracy the scene was tuned for, each resolved effect with its
+//! setting, reason and cost share; the same text is the FMU's documentation; a wrong `effects`
+//! or an accuracy statement for no output is refused naming the field.
 
 mod common;
 use common::*;
@@ -63,4 +64,68 @@ fn a_wrong_effects_entry_is_refused_naming_the_field() {
         stderr.contains("effects[1]") && stderr.contains("is not an effect"),
         "{stderr}"
     );
+}
+
+/// The scene with an `[accuracy]` statement for `output` appended.
+fn with_accuracy(dir: &std::path::Path, output: &str) -> std::path::PathBuf {
+    let scene = dir.join("tuned.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "{}\n[accuracy]\noutput = \"{output}\"\ntarget = 1e-3\nestimate = 4e-4\n",
+            c1_text()
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn explain_states_the_accuracy_the_scene_was_tuned_for_and_the_fmu_carries_it() {
+    let dir = scratch("explain_accuracy");
+    let scene = with_accuracy(&dir, "beam.tip.deflection");
+    let r = harness(&["explain".as_ref(), scene.as_os_str()]);
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let first = text.lines().next().unwrap_or_default();
+    for w in [
+        "Accuracy:",
+        "beam.tip.deflection",
+        "relative to its largest magnitude",
+        "at most 1e-3",
+        "estimate for these settings: 4.0e-4",
+    ] {
+        assert!(first.contains(w), "{w:?} not in {first:?}");
+    }
+    let fmu = dir.join("tuned.fmu");
+    let r = package(&scene, &fmu, &fake_engine(&dir, b"engine"));
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let doc = read_entry(&fmu, "documentation/index.html");
+    assert!(
+        doc.contains("<p>Accuracy: these settings were tuned"),
+        "{doc}"
+    );
+}
+
+#[test]
+fn an_accuracy_statement_for_no_output_of_the_unit_is_refused() {
+    let dir = scratch("explain_accuracy_refused");
+    // `beam` is a part of the scene, `tip.spin` no output of it
+    let scene = with_accuracy(&dir, "beam.tip.spin");
+    for command in ["explain", "package"] {
+        let fmu = dir.join("tuned.fmu");
+        let r = if command == "explain" {
+            harness(&[command.as_ref(), scene.as_os_str()])
+        } else {
+            package(&scene, &fmu, &fake_engine(&dir, b"engine"))
+        };
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{command}: {stderr}");
+        assert!(
+            stderr.contains("accuracy.output = \"beam.tip.spin\" is not a Real output")
+                && stderr.contains("beam.tip.deflection"),
+            "{command}: {stderr}"
+        );
+        assert!(!fmu.exists(), "{command}: an FMU was written");
+    }
 }

@@ -7,6 +7,7 @@
 //! Over 600 lines on purpose: the format's spec structs, whose doc comments are the generated scene
 //! reference, read in one place.
 
+mod accuracy;
 pub mod files;
 mod joint_start;
 mod laws;
@@ -24,6 +25,8 @@ pub mod xyz;
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+pub use accuracy::AccuracySpec;
 
 pub use paths::{part_path, part_paths};
 pub(crate) use placement::show_length;
@@ -85,6 +88,10 @@ pub struct Scene {
     /// geometric_stiffening, rayleigh_damping.
     #[serde(default)]
     pub effects: EffectsSpec,
+    /// The accuracy these settings were tuned for (`fmu-harness explain` states it); absent:
+    /// no statement.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<AccuracySpec>,
 }
 
 /// The scene's `effects`: a mode (`"scene"`, `"all"`, `"auto"`) or the list of effects to

@@ -303,6 +303,7 @@ pub(crate) const POSITIVE: Rule = rule(
         "solver.tolerance",
         "solver.max_step",
         "experiment.step_size",
+        "accuracy.target",
         "beam[].length",
         "beam[].material.rho",
         "beam[].material.E",
@@ -328,6 +329,7 @@ pub(crate) const POSITIVE: Rule = rule(
 pub(crate) const NON_NEGATIVE: Rule = rule(
     "non_negative",
     &[
+        "accuracy.estimate",
         "beam[].rayleigh.alpha",
         "beam[].rayleigh.beta",
         "body[].mass",
@@ -415,6 +417,27 @@ pub(crate) const TOLERANCE_BELOW_ONE: Rule = rule(
     "must be below 1",
     Any,
     Schema::Below(1.0),
+);
+pub(crate) const ACCURACY_TARGET: Rule = rule(
+    "accuracy_target",
+    &["accuracy.target"],
+    "must be below 1 (an error relative to the output's largest magnitude)",
+    Any,
+    Schema::Below(1.0),
+);
+pub(crate) const ACCURACY_ESTIMATE: Rule = rule(
+    "accuracy_estimate",
+    &["accuracy.estimate"],
+    "must be at most accuracy.target (settings tuned for a target meet it)",
+    Any,
+    Schema::None,
+);
+pub(crate) const ACCURACY_OUTPUT: Rule = rule(
+    "accuracy_output",
+    &["accuracy.output"],
+    "must name an output of the unit, <part>.<output>, where <part> is a beam, body, joint or load of the scene",
+    Any,
+    Schema::None,
 );
 /// Its text quotes [`super::validate::MIN_STEP`] (a test checks it).
 pub(crate) const MIN_STEP: Rule = rule(
@@ -1036,6 +1059,9 @@ pub const RULES: &[Rule] = &[
     IN_PLANE,
     SPATIAL_VECTOR,
     TOLERANCE_BELOW_ONE,
+    ACCURACY_TARGET,
+    ACCURACY_ESTIMATE,
+    ACCURACY_OUTPUT,
     MIN_STEP,
     MAX_STEP,
     STEP_BUDGET,

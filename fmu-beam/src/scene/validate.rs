@@ -196,6 +196,7 @@ impl Scene {
         }
         super::limits::size(&ck, self)?;
         validate_effects(&ck, self)?;
+        super::accuracy::validate(&ck, self)?;
         for (i, b) in self.bodies.iter().enumerate() {
             validate_body(&ck, b, &self.path_of(Part::Body, i), self.is_3d())?;
         }

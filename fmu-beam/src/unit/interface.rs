@@ -322,6 +322,31 @@ fn motion_slots(sys: &Mechanics) -> Vec<bool> {
     motion
 }
 
+/// The scene's `[accuracy]` statement (empty without one), or why it cannot be made: its
+/// `output` is not a Real output of the unit (the scene's own validation sees only that it
+/// names a part).
+pub fn explain_accuracy(scene: &Scene, table: &VariableTable) -> Result<String, String> {
+    let Some(a) = &scene.accuracy else {
+        return Ok(String::new());
+    };
+    let outputs: Vec<&str> = table
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Output && v.ty == VarType::Real)
+        .map(|v| v.name.as_str())
+        .collect();
+    if outputs.contains(&a.output.as_str()) {
+        return Ok(a.statement(scene));
+    }
+    const SHOWN: usize = 12;
+    let more = if outputs.len() > SHOWN { ", ..." } else { "" };
+    Err(format!(
+        "accuracy.output = {:?} is not a Real output of the unit; its outputs: {}{more}",
+        a.output,
+        outputs[..outputs.len().min(SHOWN)].join(", ")
+    ))
+}
+
 /// What the unit's FMU documentation says about its direct feedthrough and derivatives.
 pub fn explain(scene: &Scene, table: &VariableTable) -> String {
     let mut t = String::from(

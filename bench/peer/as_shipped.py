@@ -1,0 +1,201 @@
+"""The shipped scenes as a user runs them (issue 34 item 3), against the peer.
+
+    python bench/peer/as_shipped.py [--repeats N] [--fmus DIR]
+
+For each C2-C4 scene: its packaged FMU (build/fmus/<scene>.fmu) run by fmpy.simulate_fmu with
+its own DefaultExperiment and solver settings, as a user runs it; its outputs scored against
+the exact reference (bench/reference/<case>.csv) on the FMU's own output grid (error = max over
+the grid of |y - y_ref| / max |y_ref|, y_ref interpolated linearly where the grids differ); then
+Exudyn's cheapest run in build/bench/peer_points.csv (`sweep.py`) whose error is at most ours,
+re-run here. Ours and Exudyn's runs alternate (ours, Exudyn's, ours, ...) so that both see the
+same load on a shared machine.
+
+Our time is the process CPU time of the whole call a user makes, in two forms:
+  * `fmu`: simulate_fmu(path): unzips the FMU, reads modelDescription.xml, loads the engine,
+    instantiates (reads the scene, builds the system) and runs: what one call costs;
+  * `extracted`: simulate_fmu(directory) on an FMU extracted once (fmpy.extract), as a script
+    that runs a unit more than once does.
+Exudyn's time is the CPU time of its SolveSystem alone (model building excluded, as in the
+sweep). The ratio is ours / Exudyn's, median of the per-pair ratios, with min and max.
+
+Writes build/bench/as_shipped.csv and build/bench/AS_SHIPPED.md and prints the table.
+"""
+import argparse
+import csv
+import os
+import shutil
+import statistics
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import exudyn_cases as ec  # noqa: E402
+
+ROOT = os.path.normpath(os.path.join(HERE, '..', '..'))
+REF_DIR = os.path.join(ROOT, 'bench', 'reference')
+OUT_DIR = os.path.join(ROOT, 'build', 'bench')
+
+# (scene, peer case, reference column scored, how to read it from an fmpy result).
+CHORD = ('chord', 'beam')
+
+
+def output(name):
+    return ('output', name)
+
+
+SCENES = [
+    ('flexible_pendulum', 'c2', 'chord_angle', CHORD),
+    ('flexible_pendulum_substructured', 'c2', 'chord_angle', CHORD),
+    ('slider_crank', 'c3_elastic', 'slider_position', output('slider.position')),
+    ('slider_crank_rigid_crank', 'c3_rigid', 'slider_position', output('slider.position')),
+    ('spin_up_omega10', 'c4_omega10', 'tip_deflection', output('beam.tip.deflection')),
+    ('spin_up_omega4', 'c4_omega4', 'tip_deflection', output('beam.tip.deflection')),
+]
+
+
+def quantity(result, how):
+    """The scored quantity from fmpy's structured array."""
+    kind, name = how
+    if kind == 'output':
+        return np.asarray(result[name], dtype=float)
+    # the chord angle of a beam pinned at the origin, from its tip, unwrapped (it swings
+    # through -pi, where atan2 jumps), as the peer bench scores it
+    return np.unwrap(np.arctan2(result[name + '.tip.y'], result[name + '.tip.x']))
+
+
+def score(result, how, ref, column):
+    t = np.asarray(result['time'], dtype=float)
+    y = quantity(result, how)
+    y_ref = np.interp(t, ref['t'], ref[column])
+    return float(np.max(np.abs(y - y_ref)) / np.max(np.abs(ref[column])))
+
+
+def load_reference(case):
+    data = np.genfromtxt(os.path.join(REF_DIR, case + '.csv'), delimiter=',', names=True)
+    return {n: np.asarray(data[n]) for n in data.dtype.names}
+
+
+def peer_points(path):
+    with open(path, newline='') as f:
+        return [r for r in csv.DictReader(f) if r['tool'] == 'exudyn']
+
+
+def parse_setting(text):
+    """`ne=8;h=0.00025;rho_inf=0.9` or `ne_rod=4,ne_crank=2;h=...` -> run() arguments."""
+    mesh, h, rho = text.split(';')
+    args = dict(step=float(h.split('=')[1]), spectral_radius=float(rho.split('=')[1]))
+    fields = dict(kv.split('=') for kv in mesh.split(','))
+    args['ne'] = int(fields.get('ne', fields.get('ne_rod')))
+    crank = fields.get('ne_crank')
+    if crank not in (None, 'rigid'):
+        args['ne_crank'] = int(crank)
+    return args
+
+
+def cheapest_peer(points, case, column, error):
+    ok = [p for p in points if p['case'] == case and p['output'] == column
+          and float(p['error']) <= error]
+    return min(ok, key=lambda p: float(p['cpu_median'])) if ok else None
+
+
+def cpu(fn):
+    t0 = time.process_time()
+    value = fn()
+    return time.process_time() - t0, value
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--repeats', type=int, default=5)
+    ap.add_argument('--fmus', default=os.path.join(ROOT, 'build', 'fmus'))
+    ap.add_argument('--peer-points', default=os.path.join(OUT_DIR, 'peer_points.csv'))
+    ap.add_argument('--scenes', nargs='*', help='only these scenes')
+    args = ap.parse_args()
+
+    import fmpy  # noqa: E402 (the bench venv has it; imported late so --help needs nothing)
+
+    points = peer_points(args.peer_points)
+    rows = []
+    wall0 = time.time()
+    for scene, case, column, how in SCENES:
+        if args.scenes and scene not in args.scenes:
+            continue
+        fmu = os.path.join(args.fmus, scene + '.fmu')
+        ref = load_reference(case)
+        unzipdir = fmpy.extract(fmu)
+        try:
+            _, result = cpu(lambda: fmpy.simulate_fmu(fmu))
+            error = score(result, how, ref, column)
+            md = fmpy.read_model_description(fmu)
+            comm = md.defaultExperiment.stepSize
+            peer = cheapest_peer(points, case, column, error)
+            peer_args = parse_setting(peer['setting']) if peer else None
+            ours_fmu, ours_dir, theirs = [], [], []
+            for _ in range(args.repeats):
+                ours_fmu.append(cpu(lambda: fmpy.simulate_fmu(fmu))[0])
+                ours_dir.append(cpu(lambda: fmpy.simulate_fmu(unzipdir))[0])
+                if peer_args:
+                    r = ec.run(case, **peer_args)
+                    theirs.append(r.cpu)
+        finally:
+            shutil.rmtree(unzipdir, ignore_errors=True)
+        row = dict(scene=scene, case=case, output=column, comm_step=comm, error=error,
+                   ours_fmu=statistics.median(ours_fmu), ours_extracted=statistics.median(ours_dir),
+                   peer_setting=peer['setting'] if peer else 'not reached in the sweep',
+                   peer_error=float(peer['error']) if peer else float('nan'),
+                   peer_cpu=statistics.median(theirs) if theirs else float('nan'))
+        for key, ours in (('fmu', ours_fmu), ('extracted', ours_dir)):
+            ratios = [o / t for o, t in zip(ours, theirs)] if theirs else [float('nan')]
+            row['ratio_' + key] = statistics.median(ratios)
+            row['ratio_%s_min' % key] = min(ratios)
+            row['ratio_%s_max' % key] = max(ratios)
+        rows.append(row)
+        print('%-32s %-16s error %.2e  ours %.4f s (extracted %.4f s)  Exudyn %s %.2e %.4f s  '
+              'ratio %.2f (extracted %.2f)' % (
+                  scene, column, error, row['ours_fmu'], row['ours_extracted'],
+                  row['peer_setting'], row['peer_error'], row['peer_cpu'], row['ratio_fmu'],
+                  row['ratio_extracted']), flush=True)
+    os.makedirs(OUT_DIR, exist_ok=True)
+    cols = list(rows[0]) if rows else []
+    with open(os.path.join(OUT_DIR, 'as_shipped.csv'), 'w', newline='') as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for r in rows:
+            w.writerow(['%.6g' % r[c] if isinstance(r[c], float) else r[c] for c in cols])
+    load = os.getloadavg()
+    lines = [
+        '## As shipped (issue 34 item 3)',
+        '',
+        'Each scene\'s FMU run by `fmpy.simulate_fmu` with its own DefaultExperiment and solver',
+        'settings, scored against `bench/reference/` on its output grid, against Exudyn\'s',
+        'cheapest run of the sweep with an error at most ours; %d interleaved runs each, ratio ='
+        % args.repeats,
+        'ours / Exudyn\'s CPU time, median (min-max) of the pairs. `one call`: simulate_fmu on the',
+        '.fmu (unzip, load, instantiate, run); `extracted`: on the FMU extracted once.',
+        'Load average at the end: %.1f %.1f %.1f; %.0f s wall.' % (load + (time.time() - wall0,)),
+        '',
+        '| scene | output | comm. step (s) | error | ours, one call (s) | extracted (s) | '
+        'Exudyn\'s cheapest as accurate | its error | its CPU (s) | ratio, one call | '
+        'ratio, extracted |',
+        '|---|---|---|---|---|---|---|---|---|---|---|',
+    ]
+    for r in rows:
+        lines.append('| %s | %s | %g | %.2e | %.4f | %.4f | %s | %.2e | %.4f | %.2f (%.2f-%.2f) | '
+                     '%.2f (%.2f-%.2f) |' % (
+                         r['scene'], r['output'], r['comm_step'], r['error'], r['ours_fmu'],
+                         r['ours_extracted'], r['peer_setting'], r['peer_error'], r['peer_cpu'],
+                         r['ratio_fmu'], r['ratio_fmu_min'], r['ratio_fmu_max'],
+                         r['ratio_extracted'], r['ratio_extracted_min'],
+                         r['ratio_extracted_max']))
+    text = '\n'.join(lines) + '\n'
+    with open(os.path.join(OUT_DIR, 'AS_SHIPPED.md'), 'w') as f:
+        f.write(text)
+    print()
+    print(text)
+
+
+if __name__ == '__main__':
+    main()
