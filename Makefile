@@ -190,7 +190,10 @@ bench: .venv release
 # Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
 # and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
 # steps or tolerances (fmu-bench peer, about 8 min), both scored against the exact references
-# of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy.
+# of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy. Then the
+# shipped C2-C4 scenes as a user runs them (issue 34 item 3: their FMUs in fmpy with their own
+# settings, interleaved with Exudyn's cheapest run as accurate; bench/peer/as_shipped.py, about
+# 2 min): build/bench/AS_SHIPPED.md.
 VENV_BENCH  := .venv-bench
 BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp
 $(BENCH_STAMP): requirements-bench.txt
@@ -198,10 +201,11 @@ $(BENCH_STAMP): requirements-bench.txt
 	$(VENV_BENCH)/bin/pip install --quiet -r requirements-bench.txt
 	touch $@
 
-bench-peer: $(BENCH_STAMP) release
+bench-peer: $(BENCH_STAMP) release fmus
 	mkdir -p build/bench
 	$(VENV_BENCH)/bin/python bench/peer/sweep.py
 	$(BENCH) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
+	$(VENV_BENCH)/bin/python bench/peer/as_shipped.py
 
 # The accuracy study checked against the truth (issue 34 item 2): `fmu-harness accuracy` on the
 # shipped C2-C4 scenes at targets 1e-2, 1e-3, 1e-4 with --reference bench/reference/<case>.csv,

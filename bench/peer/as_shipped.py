@@ -38,7 +38,8 @@ ROOT = os.path.normpath(os.path.join(HERE, '..', '..'))
 REF_DIR = os.path.join(ROOT, 'bench', 'reference')
 OUT_DIR = os.path.join(ROOT, 'build', 'bench')
 
-# (scene, peer case, reference column scored, how to read it from an fmpy result).
+# (scene, peer case, [(reference column, how to read it from an fmpy result)]): the outputs the
+# peer's sweep scores (C2's chord angle from the tip's position).
 CHORD = ('chord', 'beam')
 
 
@@ -47,12 +48,18 @@ def output(name):
 
 
 SCENES = [
-    ('flexible_pendulum', 'c2', 'chord_angle', CHORD),
-    ('flexible_pendulum_substructured', 'c2', 'chord_angle', CHORD),
-    ('slider_crank', 'c3_elastic', 'slider_position', output('slider.position')),
-    ('slider_crank_rigid_crank', 'c3_rigid', 'slider_position', output('slider.position')),
-    ('spin_up_omega10', 'c4_omega10', 'tip_deflection', output('beam.tip.deflection')),
-    ('spin_up_omega4', 'c4_omega4', 'tip_deflection', output('beam.tip.deflection')),
+    ('flexible_pendulum', 'c2',
+     [('chord_angle', CHORD), ('tip_deflection', output('beam.tip.deflection'))]),
+    ('flexible_pendulum_substructured', 'c2',
+     [('chord_angle', CHORD), ('tip_deflection', output('beam.tip.deflection'))]),
+    ('slider_crank', 'c3_elastic',
+     [('slider_position', output('slider.position')),
+      ('rod_mid_deflection', output('rod.mid.deflection'))]),
+    ('slider_crank_rigid_crank', 'c3_rigid',
+     [('slider_position', output('slider.position')),
+      ('rod_mid_deflection', output('rod.mid.deflection'))]),
+    ('spin_up_omega10', 'c4_omega10', [('tip_deflection', output('beam.tip.deflection'))]),
+    ('spin_up_omega4', 'c4_omega4', [('tip_deflection', output('beam.tip.deflection'))]),
 ]
 
 
@@ -101,6 +108,25 @@ def cheapest_peer(points, case, column, error):
     return min(ok, key=lambda p: float(p['cpu_median'])) if ok else None
 
 
+def row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir, theirs):
+    row = dict(scene=scene, case=case, output=column, comm_step=comm, error=error,
+               ours_fmu=statistics.median(ours_fmu), ours_extracted=statistics.median(ours_dir),
+               peer_setting=peer['setting'] if peer else 'not reached in the sweep',
+               peer_error=float(peer['error']) if peer else float('nan'),
+               peer_cpu=statistics.median(theirs) if theirs else float('nan'))
+    for key, ours in (('fmu', ours_fmu), ('extracted', ours_dir)):
+        ratios = [o / t for o, t in zip(ours, theirs)] if theirs else [float('nan')]
+        row['ratio_' + key] = statistics.median(ratios)
+        row['ratio_%s_min' % key] = min(ratios)
+        row['ratio_%s_max' % key] = max(ratios)
+    print('%-32s %-18s error %.2e  ours %.4f s (extracted %.4f s)  Exudyn %s %.2e %.4f s  '
+          'ratio %.2f (extracted %.2f)' % (
+              scene, column, error, row['ours_fmu'], row['ours_extracted'], row['peer_setting'],
+              row['peer_error'], row['peer_cpu'], row['ratio_fmu'], row['ratio_extracted']),
+          flush=True)
+    return row
+
+
 def cpu(fn):
     t0 = time.process_time()
     value = fn()
@@ -120,44 +146,29 @@ def main():
     points = peer_points(args.peer_points)
     rows = []
     wall0 = time.time()
-    for scene, case, column, how in SCENES:
+    for scene, case, scored in SCENES:
         if args.scenes and scene not in args.scenes:
             continue
         fmu = os.path.join(args.fmus, scene + '.fmu')
         ref = load_reference(case)
+        comm = fmpy.read_model_description(fmu).defaultExperiment.stepSize
         unzipdir = fmpy.extract(fmu)
         try:
             _, result = cpu(lambda: fmpy.simulate_fmu(fmu))
-            error = score(result, how, ref, column)
-            md = fmpy.read_model_description(fmu)
-            comm = md.defaultExperiment.stepSize
-            peer = cheapest_peer(points, case, column, error)
-            peer_args = parse_setting(peer['setting']) if peer else None
-            ours_fmu, ours_dir, theirs = [], [], []
-            for _ in range(args.repeats):
-                ours_fmu.append(cpu(lambda: fmpy.simulate_fmu(fmu))[0])
-                ours_dir.append(cpu(lambda: fmpy.simulate_fmu(unzipdir))[0])
-                if peer_args:
-                    r = ec.run(case, **peer_args)
-                    theirs.append(r.cpu)
+            for column, how in scored:
+                error = score(result, how, ref, column)
+                peer = cheapest_peer(points, case, column, error)
+                peer_args = parse_setting(peer['setting']) if peer else None
+                ours_fmu, ours_dir, theirs = [], [], []
+                for _ in range(args.repeats):
+                    ours_fmu.append(cpu(lambda: fmpy.simulate_fmu(fmu))[0])
+                    ours_dir.append(cpu(lambda: fmpy.simulate_fmu(unzipdir))[0])
+                    if peer_args:
+                        theirs.append(ec.run(case, **peer_args).cpu)
+                rows.append(row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir,
+                                   theirs))
         finally:
             shutil.rmtree(unzipdir, ignore_errors=True)
-        row = dict(scene=scene, case=case, output=column, comm_step=comm, error=error,
-                   ours_fmu=statistics.median(ours_fmu), ours_extracted=statistics.median(ours_dir),
-                   peer_setting=peer['setting'] if peer else 'not reached in the sweep',
-                   peer_error=float(peer['error']) if peer else float('nan'),
-                   peer_cpu=statistics.median(theirs) if theirs else float('nan'))
-        for key, ours in (('fmu', ours_fmu), ('extracted', ours_dir)):
-            ratios = [o / t for o, t in zip(ours, theirs)] if theirs else [float('nan')]
-            row['ratio_' + key] = statistics.median(ratios)
-            row['ratio_%s_min' % key] = min(ratios)
-            row['ratio_%s_max' % key] = max(ratios)
-        rows.append(row)
-        print('%-32s %-16s error %.2e  ours %.4f s (extracted %.4f s)  Exudyn %s %.2e %.4f s  '
-              'ratio %.2f (extracted %.2f)' % (
-                  scene, column, error, row['ours_fmu'], row['ours_extracted'],
-                  row['peer_setting'], row['peer_error'], row['peer_cpu'], row['ratio_fmu'],
-                  row['ratio_extracted']), flush=True)
     os.makedirs(OUT_DIR, exist_ok=True)
     cols = list(rows[0]) if rows else []
     with open(os.path.join(OUT_DIR, 'as_shipped.csv'), 'w', newline='') as f:

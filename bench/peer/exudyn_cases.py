@@ -49,7 +49,7 @@ from exudyn.itemInterface import (ObjectANCFCable2D, ObjectGround, ObjectRigidBo
 G = 9.81
 
 CASES = {
-    'c2': dict(end=1.0, dt_out=1e-3, outputs=('chord_angle', 'tip_deflection')),
+    'c2': dict(end=1.0, dt_out=1e-3, outputs=('chord_angle', 'tip_deflection', 'tip_x', 'tip_y')),
     'c3_elastic': dict(end=1.6, dt_out=1e-3, outputs=('slider_position', 'rod_mid_deflection')),
     'c3_rigid': dict(end=1.6, dt_out=1e-3, outputs=('slider_position', 'rod_mid_deflection')),
     'c4_omega10': dict(end=20.0, dt_out=1e-2, outputs=('tip_deflection',), omega=10.0),
@@ -159,7 +159,9 @@ def _build_c2(mbs, ne):
         dy = tip[:, 1] - root[:, 1]
         # continuous (unwrapped) angle: the pendulum swings through -pi, where atan2 jumps
         return {'chord_angle': np.unwrap(np.arctan2(dy, dx)),
-                'tip_deflection': -ty * dx + tx * dy}
+                'tip_deflection': -ty * dx + tx * dy,
+                # the tip's position in the world (the root is pinned at the origin)
+                'tip_x': tip[:, 0], 'tip_y': tip[:, 1]}
     return outputs
 
 

@@ -40,7 +40,7 @@ impl AccuracySpec {
         format!(
             "Accuracy: these settings were tuned so that the largest error of {} over the \
              DefaultExperiment ({} s to {} s), relative to its largest magnitude, is at most \
-             {:.0e}{estimate}. `fmu-harness accuracy` re-estimates it for other targets, outputs \
+             {:e}{estimate}. `fmu-harness accuracy` re-estimates it for other targets, outputs \
              or settings; other outputs and other experiments are not covered by this statement.\n",
             self.output, e.start_time, e.stop_time, self.target
         )
