@@ -18,7 +18,8 @@ Our time is the process CPU time of the whole call a user makes, in two forms:
 Exudyn's time is the CPU time of its SolveSystem alone (model building excluded, as in the
 sweep). The ratio is ours / Exudyn's, median of the per-pair ratios, with min and max.
 
-Writes build/bench/as_shipped.csv and build/bench/AS_SHIPPED.md and prints the table.
+Writes build/bench/as_shipped.csv and build/bench/AS_SHIPPED.md, appends the table to
+build/bench/PEER.md (the peer bench's report) and prints it.
 """
 import argparse
 import csv
@@ -215,6 +216,13 @@ def main():
     text = '\n'.join(lines) + '\n'
     with open(os.path.join(OUT_DIR, 'AS_SHIPPED.md'), 'w') as f:
         f.write(text)
+    peer_report = os.path.join(OUT_DIR, 'PEER.md')
+    if os.path.exists(peer_report) and not args.scenes:
+        # the peer bench's report gains the rows (`make bench-peer` writes it just before)
+        with open(peer_report) as f:
+            report = f.read().split('\n## As shipped (issue 34 item 3)')[0].rstrip('\n')
+        with open(peer_report, 'w') as f:
+            f.write(report + '\n\n' + text)
     print()
     print(text)
 
