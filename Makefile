@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-accuracy example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -206,6 +206,13 @@ bench-peer: $(BENCH_STAMP) release fmus
 	$(VENV_BENCH)/bin/python bench/peer/sweep.py
 	$(BENCH) peer --scenes scenes --references bench/reference --peer-points build/bench/peer_points.csv --output build/bench
 	$(VENV_BENCH)/bin/python bench/peer/as_shipped.py
+
+# The peer table timed again interleaved (issue 34 item 4): the two runs behind each ratio of
+# the last `make bench-peer` (its build/bench/ours_points.csv and peer_points.csv; not rerun
+# here), ours (`fmu-bench peer-run`) and Exudyn's in turns, 5 rounds (3 for the longest pairs);
+# build/bench/INTERLEAVED.md and interleaved.csv; about 10 min.
+bench-interleaved: $(BENCH_STAMP) release
+	$(VENV_BENCH)/bin/python bench/peer/interleaved.py
 
 # The accuracy study checked against the truth (issue 34 item 2): `fmu-harness accuracy` on the
 # shipped C2-C4 scenes at targets 1e-2, 1e-3, 1e-4 with --reference bench/reference/<case>.csv,

@@ -1,6 +1,7 @@
 //! fmu-bench: the benchmarks of the engine, beside the product (`make bench`, `make
 //! bench-peer`): `work-precision` (error against CPU time over formulations, integrator
-//! settings and effects), `peer` (C2–C4 against the exact references and against Exudyn) and
+//! settings and effects), `peer` (C2–C4 against the exact references and against Exudyn),
+//! `peer-run` (one of its settings alone, for `bench/peer/interleaved.py` and callgrind) and
 //! `linear-solvers` (dense against sparse LU of the iteration matrix).
 
 mod error;
@@ -78,6 +79,33 @@ enum Command {
         /// report again, in seconds.
         #[arg(long)]
         ours_points: Option<PathBuf>,
+    },
+    /// One of our peer settings alone: a case, a formulation and a setting as
+    /// ours_points.csv names them; prints one JSON line: CPU seconds (thread) of the first run
+    /// and of each sample, errors against the reference, steps, Newton iterations, iteration
+    /// matrices and unknowns (`bench/peer/interleaved.py`; under callgrind with --samples 0).
+    PeerRun {
+        /// Directory of the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Directory of the reference CSVs.
+        #[arg(long, default_value = "bench/reference")]
+        references: PathBuf,
+        /// c2, c3_elastic, c3_rigid, c4_omega10 or c4_omega4.
+        #[arg(long)]
+        case: String,
+        /// A formulation of the case, e.g. "10 x 2 substructures".
+        #[arg(long)]
+        formulation: String,
+        /// A setting, e.g. "fixed step 1.0e-3 s, tolerance 1e-8" or "tolerance 1e-6".
+        #[arg(long)]
+        setting: String,
+        /// End time (s) instead of the case's (a multiple of its communication step).
+        #[arg(long)]
+        stop: Option<f64>,
+        /// Timed samples after the first run (0: the first run only).
+        #[arg(long, default_value_t = 1)]
+        samples: usize,
     },
     /// Dense against sparse LU of the iteration matrix: C2's pendulum and C4's spin-up with
     /// k = 5…80 substructures and C1's beam with e elements, at fixed steps; CPU time per step,
@@ -213,6 +241,26 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<(), BenchError> {
                 writeln!(out, "wrote {}", path.display()).map_err(stdout_err)?;
             }
             out.write_all(text.as_bytes()).map_err(stdout_err)?;
+        }
+        Command::PeerRun {
+            scenes,
+            references,
+            case,
+            formulation,
+            setting,
+            stop,
+            samples,
+        } => {
+            let line = work_precision::peer_run::run(&work_precision::peer_run::Request {
+                scenes: &scenes,
+                references: &references,
+                case: &case,
+                formulation: &formulation,
+                setting: &setting,
+                stop,
+                samples,
+            })?;
+            writeln!(out, "{line}").map_err(stdout_err)?;
         }
         Command::LinearSolvers {
             scenes,

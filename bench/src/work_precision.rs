@@ -16,6 +16,7 @@ pub mod cases;
 pub mod exact;
 pub mod overhead;
 pub mod peer;
+pub mod peer_run;
 pub mod report;
 pub mod spatial;
 

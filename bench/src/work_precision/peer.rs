@@ -230,7 +230,7 @@ pub struct PeerPoint {
 }
 
 /// Columns of a reference CSV: names and rows.
-fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), BenchError> {
+pub(super) fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), BenchError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| BenchError::io(path, "reading the reference", e))?;
     let bad = |what: &str| BenchError::Input {
@@ -306,8 +306,17 @@ pub(super) fn configure(
     Ok(Scene::from_toml_str(&s.to_toml_string(), &origin)?)
 }
 
-/// Runs `scene` over the case's grid; values per output of the case.
+/// Runs `scene` over the case's grid; values per output of the case, and the counters: steps,
+/// Newton iterations, iteration matrices.
 fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
+    simulate_engine(scene, case).map(|(series, _)| series)
+}
+
+/// [`simulate`], and the engine at the end of the run (its other counters).
+pub(super) fn simulate_engine(
+    scene: &Scene,
+    case: &PeerCase,
+) -> Result<(Series, Engine), EngineError> {
     let start = Instant::now();
     let cpu0 = thread_cpu_seconds();
     let mut e = Engine::new(scene.clone());
@@ -355,17 +364,24 @@ fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
         (Some(a), Some(b)) => b - a,
         _ => start.elapsed().as_secs_f64(),
     };
-    let steps = e
-        .variables()
-        .by_name("solver.steps")
-        .map(|v| v.vr)
-        .map_or(Ok(0), |v| e.get_integer(v))?;
-    Ok(Series {
+    let mut stat = |name| {
+        e.variables()
+            .by_name(name)
+            .map(|v| v.vr)
+            .map_or(Ok(0), |v| e.get_integer(v).map(i64::from))
+    };
+    let stats = [
+        stat("solver.steps")?,
+        stat("solver.newton_iterations")?,
+        stat("solver.jacobians")?,
+    ];
+    let series = Series {
         values,
         missing: Vec::new(),
         seconds,
-        stats: [steps as i64, 0, 0],
-    })
+        stats,
+    };
+    Ok((series, e))
 }
 
 /// Runs every case; `progress` receives a line per point. A setting whose run of a formulation

@@ -113,6 +113,18 @@ impl JacobianRows {
         self.values[k] += x;
     }
 
+    /// The stored values of row `row` from column `col` to the end of the body's columns that
+    /// hold it: entry k is G[row, col + k]. Panics where `col` is off the row's pattern.
+    #[inline]
+    pub fn row_from(&mut self, row: usize, col: usize) -> &mut [f64] {
+        let s = self.segments[row]
+            .iter()
+            .find(|s| col >= s.col && col < s.col + s.len)
+            .copied()
+            .unwrap_or_else(|| panic!("G[{row}, {col}] is outside the constraint row's bodies"));
+        &mut self.values[s.at + col - s.col..s.at + s.len]
+    }
+
     /// Where G[row, col] is stored, if it lies in the pattern.
     fn index(&self, row: usize, col: usize) -> Option<usize> {
         self.segments[row]

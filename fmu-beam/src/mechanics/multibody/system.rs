@@ -211,8 +211,9 @@ impl System {
         c: f64,
     ) {
         if let Some(b) = f.body {
-            let o = self.offsets[b];
-            f.for_each_jacobian(w, c, |k, x| out.add(row, o + k, x));
+            // the body's stored entries found once, not once per coordinate
+            let body = out.row_from(row, self.offsets[b]);
+            f.for_each_jacobian(w, c, |k, x| body[k] += x);
         }
     }
 
