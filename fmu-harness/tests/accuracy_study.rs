@@ -265,6 +265,11 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
     // the exact series, written to 6 digits: the true error of the 4 ms step, 1.425e-3
     let truth: f64 = first[11].parse().unwrap();
     assert!((truth - 1.425e-3).abs() < 0.01e-3, "{truth}");
+    // the scene at the chosen setting, to run as it is (and for `fmu-bench choice`)
+    assert!(stdout.contains("chosen.toml"), "{stdout}");
+    let chosen = fmu_beam::Scene::load(&dir.join("chosen.toml")).unwrap();
+    assert!(!chosen.solver.adaptive);
+    assert!(chosen.solver.max_step <= 4e-3);
     let png = std::fs::read(dir.join("accuracy.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert_eq!(&png[16..24], [0, 0, 2, 208, 0, 0, 1, 224], "720 × 480");

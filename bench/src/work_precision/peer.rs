@@ -230,7 +230,7 @@ pub struct PeerPoint {
 }
 
 /// Columns of a reference CSV: names and rows.
-fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), BenchError> {
+pub(super) fn read_reference(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), BenchError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| BenchError::io(path, "reading the reference", e))?;
     let bad = |what: &str| BenchError::Input {
@@ -274,6 +274,20 @@ fn setting_name(setting: Setting, newton: Option<f64>) -> String {
     }
 }
 
+/// A setting as [`setting_name`] writes it, read back: the integrator setting, and a fixed
+/// step's Newton tolerance where it is not the scene's.
+pub(super) fn parse_setting(name: &str) -> Option<(Setting, Option<f64>)> {
+    let (family, size) = family(name)?;
+    match family.as_str() {
+        "tolerance" => Some((Setting::Tolerance(size), None)),
+        "fixed step" => Some((Setting::FixedStep(size), None)),
+        f => {
+            let t = f.strip_prefix("fixed step, tolerance ")?.trim().parse().ok()?;
+            Some((Setting::FixedStep(size), Some(t)))
+        }
+    }
+}
+
 /// The scene of a formulation at a setting. A fixed step runs Newton at `newton`, or at the
 /// scene's tolerance without it ([`FIXED_STEP_TOLERANCES`]); error control keeps the scene's
 /// largest step.
@@ -307,7 +321,7 @@ pub(super) fn configure(
 }
 
 /// Runs `scene` over the case's grid; values per output of the case.
-fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
+pub(super) fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
     let start = Instant::now();
     let cpu0 = thread_cpu_seconds();
     let mut e = Engine::new(scene.clone());
@@ -556,7 +570,7 @@ fn meets(points: &[PeerPoint], p: &PeerPoint, target: f64) -> bool {
 
 /// The cheapest point (median CPU) meeting `target` for good ([`meets`]), among those of
 /// `tool` for (case, output).
-fn cheapest<'a>(
+pub(super) fn cheapest<'a>(
     points: &'a [PeerPoint],
     tool: &str,
     case: &str,
@@ -852,6 +866,19 @@ mod tests {
             seconds: [cpu; 3],
             steps: 0,
         }
+    }
+
+    #[test]
+    fn setting_names_read_back() {
+        for (setting, newton) in [
+            (Setting::FixedStep(2e-5), None),
+            (Setting::FixedStep(1e-3), Some(1e-8)),
+            (Setting::Tolerance(1e-6), None),
+        ] {
+            let back = parse_setting(&setting_name(setting, newton));
+            assert_eq!(back, Some((setting, newton)));
+        }
+        assert_eq!(parse_setting("ne=16;h=5e-05;rho_inf=0.9"), None);
     }
 
     #[test]

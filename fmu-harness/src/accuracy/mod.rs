@@ -21,7 +21,7 @@ pub mod truth;
 use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
 use fmu_beam::{Engine, Scene, VarType};
 pub use options::{AccuracyError, Options};
-use runner::{fine_end, mesh_text, refinable, Grid, Runner};
+use runner::{fine_end, mesh_text, refinable, scene_at, Grid, Runner};
 use std::path::Path;
 use std::time::Instant;
 
@@ -136,6 +136,8 @@ pub struct Choice {
     pub newton_share: Option<f64>,
     /// The difference when geometric stiffening is switched (or why it could not be).
     pub stiffening_change: Option<Result<f64, String>>,
+    /// The scene at the chosen setting, as TOML (the command writes it as `chosen.toml`).
+    pub scene_toml: String,
 }
 
 /// A finished study.
@@ -553,6 +555,9 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
                 finer,
                 newton_share,
                 stiffening_change,
+                scene_toml: scene_at(&base, &setting)
+                    .map(|s| s.to_toml_string())
+                    .unwrap_or_default(),
             });
         }
     }
