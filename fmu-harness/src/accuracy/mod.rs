@@ -118,6 +118,9 @@ impl Run {
 #[derive(Debug, Clone)]
 pub struct Choice {
     pub setting: Setting,
+    /// The ladder's setting it was relaxed from (a larger step, up to the coarser rung, and
+    /// the coarsest rung's Newton tolerance), or the same where the relaxed run missed.
+    pub ladder: Setting,
     /// Before the run: the norm of its time error (at the scene's mesh) plus its mesh error
     /// (at the mesh ladder's step), added as functions of time (they may cancel; their norms'
     /// sum, `time_share + mesh_share`, bounds it).
@@ -242,6 +245,12 @@ fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -
     };
     estimate(r, rungs, &pk, nominal)
         .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
+}
+
+/// `x` rounded down to three significant digits (a step a scene can carry as written).
+fn three_digits_down(x: f64) -> f64 {
+    let m = 10f64.powi(2 - x.log10().floor() as i32);
+    (x * m).floor() / m
 }
 
 /// Runs the study of `scene_path`.
@@ -477,16 +486,67 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             }
         }
     }
+    let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
+    let p_time = order(&time, TIME_ORDER);
     let mut choice = None;
-    if let Some((k, j, predicted, predicted_seconds)) = best {
-        let setting = at(k, j as u32);
+    if let Some((k, j, ladder_predicted, ladder_seconds)) = best {
+        let ladder_setting = at(k, j as u32);
+        // relaxed: the largest step up to the coarser rung (quarter octaves) that the time
+        // ladder's order predicts to meet, at Newton's tolerance of the coarsest rung (the
+        // ladder's tighter ones are for its differences); kept only if its run's estimated
+        // error (its distance to the limit, which holds its Newton error) meets the target
+        let stretch = (0..4)
+            .rev()
+            .map(|i| 2f64.powf(f64::from(i) / 4.0))
+            .filter(|&s| k > 0 || s == 1.0)
+            .find_map(|s| {
+                let e = error_of(k, j, s.powf(p_time), 1.0, &r)?;
+                let d = distance(&e, &zero, &peaks);
+                (d * margin <= opts.target).then_some((s, d))
+            });
+        let mut picked = (ladder_setting, 1.0, ladder_predicted, ladder_seconds);
+        if let Some((s, d)) = stretch {
+            let relaxed = Setting {
+                step: if s > 1.0 {
+                    three_digits_down(ladder_setting.step * s)
+                } else {
+                    ladder_setting.step
+                },
+                newton: tol0,
+                ..ladder_setting
+            };
+            if relaxed != ladder_setting {
+                let seconds = ladder_seconds / s;
+                let kept = r.run(Role::Chosen, relaxed, seconds).and_then(|i| {
+                    let e = distance(r.values(i)?, &limit, &peaks);
+                    if e * margin <= opts.target {
+                        Some(i)
+                    } else {
+                        r.notes.push(format!(
+                            "relaxed setting h = {:e} s, Newton's tolerance {:.0e}: estimated                              error {e:.2e} × {margin} misses the target; the ladder's setting                              h = {:e} s, tolerance {:.0e} kept",
+                            relaxed.step, relaxed.newton, ladder_setting.step, ladder_setting.newton
+                        ));
+                        None
+                    }
+                });
+                if kept.is_some() {
+                    picked = (relaxed, s, d, seconds);
+                }
+            }
+        }
+        let (setting, s, predicted, predicted_seconds) = picked;
         let existing = r
             .runs
             .iter()
             .position(|x| x.setting == setting && x.result.is_ok());
         let run = existing.or_else(|| r.run(Role::Chosen, setting, predicted_seconds));
         if let Some(run) = run.filter(|&i| r.values(i).is_some()) {
-            let finer_setting = at(k + 1, j as u32 + u32::from(has_mesh));
+            let finer_setting = Setting {
+                step: setting.step / 2.0,
+                newton: (setting.newton / NEWTON_PER_HALVING).max(1e-14),
+                mesh: j as u32 + u32::from(has_mesh),
+                stiffening_switched: false,
+            };
             let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
             // a ladder's run at that setting serves (C4: the mesh ladder ran at the step above)
             let finer = r
@@ -531,11 +591,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
                 None
             };
             // the finer run has each error divided by 2^order: the difference to expect
-            let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
             let expected_difference = error_of(
                 k,
                 j,
-                1.0 - 0.5f64.powf(order(&time, TIME_ORDER)),
+                s.powf(p_time) * (1.0 - 0.5f64.powf(p_time)),
                 if has_mesh {
                     1.0 - 0.5f64.powf(order(&mesh, MESH_ORDER))
                 } else {
@@ -546,9 +605,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             .map_or(f64::NAN, |e| distance(&e, &zero, &peaks));
             choice = Some(Choice {
                 setting,
+                ladder: ladder_setting,
                 predicted,
                 expected_difference,
-                time_share: time_shares[k].unwrap_or(0.0),
+                time_share: time_shares[k].unwrap_or(0.0) * s.powf(p_time),
                 mesh_share: mesh_shares[j].unwrap_or(0.0),
                 predicted_seconds,
                 run,

@@ -222,6 +222,16 @@ pub fn markdown(study: &Study) -> String {
                 c.setting.newton,
                 mesh_of(study, run)
             );
+            if c.setting != c.ladder {
+                let _ = writeln!(
+                    s,
+                    "Relaxed from the ladder's setting (h = {:e} s, Newton's tolerance {:.0e}): \
+                     the largest step up to the coarser rung that the time ladder's order \
+                     predicts to meet, at the coarsest rung's Newton tolerance; kept because \
+                     its run's estimated error times {} meets the target.\n",
+                    c.ladder.step, c.ladder.newton, study.margin
+                );
+            }
             let _ = writeln!(s, "## How sure\n");
             match c.finer {
                 Some((i, d)) => {
