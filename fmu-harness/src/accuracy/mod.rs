@@ -21,7 +21,7 @@ pub mod truth;
 use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
 use fmu_beam::{Engine, Scene, VarType};
 pub use options::{AccuracyError, Options};
-use runner::{fine_end, mesh_text, refinable, scene_at, Grid, Runner};
+use runner::{coarsenable, fine_end, mesh_text, refinable, scene_at, Grid, Runner};
 use std::path::Path;
 use std::time::Instant;
 
@@ -78,8 +78,9 @@ pub struct Setting {
     pub step: f64,
     /// Newton's tolerance.
     pub newton: f64,
-    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh.
-    pub mesh: u32,
+    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh (−1: halved, where
+    /// every count is even).
+    pub mesh: i32,
     /// Every flexible beam's geometric stiffening switched.
     pub stiffening_switched: bool,
 }
@@ -152,7 +153,7 @@ pub struct Study {
     pub start: f64,
     pub stop: f64,
     pub comm: f64,
-    /// The mesh of each level, as text (`beam 10 el.`).
+    /// The mesh of each level from −1 (halved) up, as text (`beam 10 el.`).
     pub meshes: Vec<String>,
     pub runs: Vec<Run>,
     pub time: Option<Ladder>,
@@ -162,7 +163,7 @@ pub struct Study {
     /// The choice's predicted error times this meets the target ([`SAFETY_OBSERVED`],
     /// [`SAFETY_ASSUMED`]).
     pub margin: f64,
-    /// Per time level and per mesh level: the estimated shares.
+    /// Per time level and per mesh level (from the coarsest that ran): the estimated shares.
     pub time_shares: Vec<Option<f64>>,
     pub mesh_shares: Vec<Option<f64>>,
     pub choice: Option<Choice>,
@@ -333,7 +334,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         notes: Vec::new(),
         bar,
     };
-    let at = |level: usize, mesh: u32| Setting {
+    let at = |level: usize, mesh: i32| Setting {
         step: h0 / 2f64.powi(level as i32),
         newton: (tol0 / NEWTON_PER_HALVING.powi(level as i32)).max(1e-14),
         mesh,
@@ -403,7 +404,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             {
                 break;
             }
-            let i = r.run(Role::Mesh, at(mesh_level, j as u32), 2.5 * cost);
+            let i = r.run(Role::Mesh, at(mesh_level, j as i32), 2.5 * cost);
             if let Some(i) = i {
                 cost = r.runs[i].seconds;
             }
@@ -417,10 +418,23 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     let mesh = mesh_estimate.as_ref().and_then(|e| e.ladder.clone());
     // the limit: the mesh ladder's, moved by the time ladder's correction at its step
     let base_at_mesh_step = time_runs[mesh_level].and_then(|i| r.values(i)).cloned();
-    let (limit, mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
+    let (limit, mut mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
         (Some(m), Some(e), Some(b)) => (shifted(&m.limit, &time_limit, b), e.shares.clone()),
         _ => (time_limit.clone(), vec![Some(0.0)]),
     };
+    // a halved mesh, where every count is even: not in the extrapolation, a candidate whose
+    // share is its distance to the mesh ladder's limit (the scene's mesh may be finer than the
+    // target needs); `offset` is the scene's mesh's index in `mesh_runs`
+    let mut offset = 0;
+    if let (Some(e), true) = (&mesh_estimate, mesh.is_some() && coarsenable(&base)) {
+        let cost = mesh_runs[0].map_or(0.0, |i| r.runs[i].seconds) / 2.0;
+        if let Some(i) = r.run(Role::Mesh, at(mesh_level, -1), cost) {
+            let share = r.values(i).map(|y| distance(y, &e.limit, &peaks));
+            mesh_runs.insert(0, Some(i));
+            mesh_shares.insert(0, share);
+            offset = 1;
+        }
+    }
     if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
         r.notes.push(
             "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
@@ -434,7 +448,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     // the choice: the cheapest (step, mesh) whose predicted error meets the target
     let cost_of = |k: usize, j: usize, r: &Runner| -> Option<f64> {
         let c = r.runs[time_runs[k]?].seconds;
-        let m0 = r.runs[mesh_runs[0]?].seconds;
+        let m0 = r.runs[mesh_runs[offset]?].seconds;
         let mj = r.runs[(*mesh_runs.get(j)?)?].seconds;
         Some(c * mj / m0.max(1e-9))
     };
@@ -490,7 +504,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     let p_time = order(&time, TIME_ORDER);
     let mut choice = None;
     if let Some((k, j, ladder_predicted, ladder_seconds)) = best {
-        let ladder_setting = at(k, j as u32);
+        let ladder_setting = at(k, j as i32 - offset as i32);
         // relaxed: the largest step up to the coarser rung (quarter octaves) that the time
         // ladder's order predicts to meet, at Newton's tolerance of the coarsest rung (the
         // ladder's tighter ones are for its differences); kept only if its run's estimated
@@ -544,7 +558,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             let finer_setting = Setting {
                 step: setting.step / 2.0,
                 newton: (setting.newton / NEWTON_PER_HALVING).max(1e-14),
-                mesh: j as u32 + u32::from(has_mesh),
+                mesh: setting.mesh + i32::from(has_mesh),
                 stiffening_switched: false,
             };
             let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
@@ -637,7 +651,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         start,
         stop: start + n as f64 * comm,
         comm,
-        meshes: (0..=MAX_MESH_LEVELS as u32)
+        meshes: (-1..=MAX_MESH_LEVELS as i32)
             .map(|j| mesh_text(&base, j))
             .collect(),
         runs: r.runs,

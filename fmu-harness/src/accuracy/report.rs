@@ -54,7 +54,7 @@ pub fn csv(study: &Study) -> String {
 fn mesh_of(study: &Study, r: &Run) -> String {
     study
         .meshes
-        .get(r.setting.mesh as usize)
+        .get((r.setting.mesh + 1).max(0) as usize)
         .cloned()
         .unwrap_or_default()
 }
