@@ -1,6 +1,7 @@
 //! fmu-bench: the benchmarks of the engine, beside the product (`make bench`, `make
 //! bench-peer`): `work-precision` (error against CPU time over formulations, integrator
-//! settings and effects), `peer` (C2–C4 against the exact references and against Exudyn) and
+//! settings and effects), `peer` (C2–C4 against the exact references and against Exudyn),
+//! `choice` (the accuracy study's chosen scene against the cheapest of our peer points) and
 //! `linear-solvers` (dense against sparse LU of the iteration matrix).
 
 mod error;

@@ -242,7 +242,10 @@ fn the_mesh_ladder_also_runs_a_halved_mesh_where_every_count_halves() {
     assert!((1.0 / 3.0..=3.0).contains(&(est / t)), "{est:.3e} {t:.3e}");
     assert!(s.mesh_shares.len() >= 4, "{:?}", s.mesh_shares);
 
-    let path = write_scene("odd", &scene_text(BETA).replace("elements = 4", "elements = 3"));
+    let path = write_scene(
+        "odd",
+        &scene_text(BETA).replace("elements = 4", "elements = 3"),
+    );
     let mut o = Options::new(vec!["beam.tip.deflection".into()], 1e-3);
     o.step = Some(4e-3);
     let odd = accuracy::study(&path, &o).unwrap();

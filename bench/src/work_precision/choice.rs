@@ -92,11 +92,13 @@ pub fn describe(s: &Scene) -> String {
     };
     for b in s.beams.iter().filter(|b| !b.rigid) {
         match b.substructures {
-            Some(k) => t += &format!(
-                ", {} {k}×{}",
-                b.name,
-                b.elements_per_substructure.unwrap_or(1)
-            ),
+            Some(k) => {
+                t += &format!(
+                    ", {} {k}×{}",
+                    b.name,
+                    b.elements_per_substructure.unwrap_or(1)
+                )
+            }
             None => t += &format!(", {} {} el.", b.name, b.elements.unwrap_or(1)),
         }
     }

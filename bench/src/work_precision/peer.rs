@@ -282,7 +282,11 @@ pub(super) fn parse_setting(name: &str) -> Option<(Setting, Option<f64>)> {
         "tolerance" => Some((Setting::Tolerance(size), None)),
         "fixed step" => Some((Setting::FixedStep(size), None)),
         f => {
-            let t = f.strip_prefix("fixed step, tolerance ")?.trim().parse().ok()?;
+            let t = f
+                .strip_prefix("fixed step, tolerance ")?
+                .trim()
+                .parse()
+                .ok()?;
             Some((Setting::FixedStep(size), Some(t)))
         }
     }

@@ -46,10 +46,12 @@ pub(super) fn scene_at(base: &Scene, s: &Setting) -> Result<Scene, String> {
 fn scaled(count: usize, mesh: i32) -> Result<usize, String> {
     if mesh >= 0 {
         Ok(count << mesh)
-    } else if count % (1 << -mesh) == 0 {
+    } else if count.is_multiple_of(1 << -mesh) {
         Ok(count >> -mesh)
     } else {
-        Err(format!("{count} elements or substructures cannot be halved"))
+        Err(format!(
+            "{count} elements or substructures cannot be halved"
+        ))
     }
 }
 
@@ -60,7 +62,7 @@ pub(super) fn coarsenable(base: &Scene) -> bool {
     beams.peek().is_some()
         && beams.all(|b| {
             let count = b.substructures.unwrap_or(b.elements.unwrap_or(1));
-            count % 2 == 0
+            count.is_multiple_of(2)
         })
 }
 

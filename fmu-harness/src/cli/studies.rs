@@ -100,7 +100,10 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
         let chosen = dir.join("chosen.toml");
         std::fs::write(&chosen, &c.scene_toml)
             .map_err(|e| HarnessError::io(&chosen, "writing the chosen scene", e))?;
-        wrote = format!("{}, {wrote} (the scene at the chosen setting)", chosen.display());
+        wrote = format!(
+            "{}, {wrote} (the scene at the chosen setting)",
+            chosen.display()
+        );
     }
     write!(
         out,
