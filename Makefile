@@ -228,7 +228,9 @@ bench-accuracy: release
 # most 1.5x): after `make bench-accuracy` and `make bench-peer` (build/bench/ours_points.csv),
 # each study's chosen.toml and the cheapest of our peer points meeting the same target on the
 # same output, timed in one process (`fmu-bench choice`, 5 rounds, the order alternating);
-# writes build/accuracy/CHOICE.md.
+# writes build/accuracy/CHOICE.md. CHOICE_SCENES: the scenes the peer sweep ran, where they are not
+# these (the peer's settings are rebuilt from them).
+CHOICE_SCENES ?= scenes
 bench-choice: release
 	mkdir -p build/accuracy
 	h=--header; : > build/accuracy/CHOICE.md; \
@@ -237,7 +239,7 @@ bench-choice: release
 	  for t in 1e-2 1e-3 1e-4; do \
 	    f=build/accuracy/$$case-$$t/chosen.toml; \
 	    if [ -f $$f ]; then \
-	      nice $(BENCH) choice --case $$case --output $$column --target $$t --chosen $$f $$h \
+	      nice $(BENCH) choice --scenes $(CHOICE_SCENES) --case $$case --output $$column --target $$t --chosen $$f $$h \
 	        >> build/accuracy/CHOICE.md 2> build/accuracy/choice.err && h= \
 	      || echo "| $$case $$column | $$t | $$(tail -1 build/accuracy/choice.err) | | |" >> build/accuracy/CHOICE.md; \
 	    else echo "| $$case $$column | $$t | no choice (target not met) | | |" >> build/accuracy/CHOICE.md; fi; \
