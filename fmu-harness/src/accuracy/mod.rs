@@ -9,7 +9,14 @@
 //! mesh) whose predicted error (its time and mesh errors added over time) times a safety
 //! factor meets the target is run, checked against a run refined in both,
 //! and probed for Newton's share and for the geometric stiffening's (a choice of physics).
-//! [`report`] writes the table, [`plot`] the work-precision chart.
+//! Before it runs, the choice is relaxed (a larger step up to the coarser rung, at the coarsest
+//! rung's Newton tolerance) where that run's own estimate meets the target; where every count
+//! halves, the mesh ladder also offers the halved mesh. [`report`] writes the table, [`plot`]
+//! the work-precision chart.
+//!
+//! Over 600 lines: the study is one sequence (ladders, limit, choice, its relaxation, checks)
+//! whose steps share the runs and their estimates; split, each part would take most of them as
+//! arguments.
 
 pub mod estimate;
 mod options;
