@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice example-split example-hinge example-arm example-sweep clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -232,6 +232,29 @@ bench-accuracy: release
 	      --reference bench/reference/$$case.csv --column $$column --max-seconds 150 \
 	      --dir build/accuracy/$$case-$$t > build/accuracy/$$case-$$t.md || exit 1; \
 	    echo "$$case $$t: $$(grep -o 'Against the reference.*\|No setting.*' build/accuracy/$$case-$$t.md)"; \
+	  done; \
+	done
+
+# The accuracy study's choice against the peer bench's cheapest setting (issue 34 item 2: at
+# most 1.5x): after `make bench-accuracy` and `make bench-peer` (build/bench/ours_points.csv),
+# each study's chosen.toml and the cheapest of our peer points meeting the same target on the
+# same output, timed in one process (`fmu-bench choice`, 5 rounds, the order alternating);
+# writes build/accuracy/CHOICE.md. CHOICE_SCENES: the scenes the peer sweep ran, where they are not
+# these (the peer's settings are rebuilt from them).
+CHOICE_SCENES ?= scenes
+bench-choice: release
+	mkdir -p build/accuracy
+	h=--header; : > build/accuracy/CHOICE.md; \
+	for c in $(ACCURACY_CASES); do \
+	  IFS=: read scene case output column <<< "$$c"; \
+	  for t in 1e-2 1e-3 1e-4; do \
+	    f=build/accuracy/$$case-$$t/chosen.toml; \
+	    if [ -f $$f ]; then \
+	      nice $(BENCH) choice --scenes $(CHOICE_SCENES) --case $$case --output $$column --target $$t --chosen $$f $$h \
+	        >> build/accuracy/CHOICE.md 2> build/accuracy/choice.err && h= \
+	      || echo "| $$case $$column | $$t | $$(tail -1 build/accuracy/choice.err) | | |" >> build/accuracy/CHOICE.md; \
+	    else echo "| $$case $$column | $$t | no choice (target not met) | | |" >> build/accuracy/CHOICE.md; fi; \
+	    tail -1 build/accuracy/CHOICE.md; \
 	  done; \
 	done
 

@@ -1,7 +1,8 @@
 //! fmu-bench: the benchmarks of the engine, beside the product (`make bench`, `make
 //! bench-peer`): `work-precision` (error against CPU time over formulations, integrator
 //! settings and effects), `peer` (C2–C4 against the exact references and against Exudyn),
-//! `peer-run` (one of its settings alone, for `bench/peer/interleaved.py` and callgrind) and
+//! `peer-run` (one of its settings alone, for `bench/peer/interleaved.py` and callgrind),
+//! `choice` (the accuracy study's chosen scene against the cheapest of our peer points) and
 //! `linear-solvers` (dense against sparse LU of the iteration matrix).
 
 mod error;
@@ -106,6 +107,38 @@ enum Command {
         /// Timed samples after the first run (0: the first run only).
         #[arg(long, default_value_t = 1)]
         samples: usize,
+    },
+    /// The accuracy study's choice against the peer bench's cheapest (issue 34 item 2): the
+    /// scene `fmu-harness accuracy` chose for a target and the cheapest of our peer points
+    /// meeting it on the same output, timed in one process round by round; prints a table row.
+    Choice {
+        /// Directory of the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Directory of the reference CSVs.
+        #[arg(long, default_value = "bench/reference")]
+        references: PathBuf,
+        /// Our points of the peer sweep.
+        #[arg(long, default_value = "build/bench/ours_points.csv")]
+        ours_points: PathBuf,
+        /// The peer case (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
+        #[arg(long)]
+        case: String,
+        /// The reference column (tip_deflection, slider_position, ...).
+        #[arg(long)]
+        output: String,
+        /// The error target.
+        #[arg(long)]
+        target: f64,
+        /// The study's chosen scene (`chosen.toml` in its folder).
+        #[arg(long)]
+        chosen: PathBuf,
+        /// Timed rounds (median, least and largest are reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Print the table's header first.
+        #[arg(long)]
+        header: bool,
     },
     /// Dense against sparse LU of the iteration matrix: C2's pendulum and C4's spin-up with
     /// k = 5…80 substructures and C1's beam with e elements, at fixed steps; CPU time per step,
@@ -261,6 +294,42 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<(), BenchError> {
                 samples,
             })?;
             writeln!(out, "{line}").map_err(stdout_err)?;
+        }
+        Command::Choice {
+            scenes,
+            references,
+            ours_points,
+            case,
+            output,
+            target,
+            chosen,
+            repeats,
+            header,
+        } => {
+            use work_precision::{choice, peer};
+            let c = peer::cases()
+                .into_iter()
+                .find(|c| c.name == case)
+                .ok_or_else(|| BenchError::Input {
+                    origin: "--case".into(),
+                    message: format!("no peer case {case}"),
+                })?;
+            let ours = peer::read_peer(&ours_points)?;
+            let row = choice::compare(
+                &scenes,
+                &references,
+                &c,
+                &output,
+                target,
+                &chosen,
+                &ours,
+                repeats,
+            )?
+            .row();
+            if header {
+                writeln!(out, "{}", choice::HEADER).map_err(stdout_err)?;
+            }
+            writeln!(out, "{row}").map_err(stdout_err)?;
         }
         Command::LinearSolvers {
             scenes,

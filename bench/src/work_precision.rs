@@ -13,6 +13,7 @@
 //! benchmark, not the product.
 
 pub mod cases;
+pub mod choice;
 pub mod exact;
 pub mod overhead;
 pub mod peer;

@@ -193,6 +193,66 @@ fn the_chosen_settings_meet_the_target_against_the_exact_answer() {
     }
 }
 
+/// The choice relaxes the ladder's setting (a step up to the coarser rung that the time
+/// ladder's order predicts to meet, Newton at the coarsest rung's tolerance) only where the
+/// relaxed run's own estimate meets the target; the truth agrees.
+#[test]
+fn the_choice_relaxes_the_ladders_setting_only_where_its_run_meets_the_target() {
+    let mut relaxed = 0;
+    for target in [1e-3, 1e-4] {
+        let (s, truth) = study(&format!("relaxed{target:e}"), target);
+        let c = s.choice.as_ref().expect("a choice");
+        let (chosen, ladder) = (c.setting, c.ladder);
+        assert!(
+            chosen.step >= ladder.step && chosen.step < 2.0 * ladder.step,
+            "{chosen:?} from {ladder:?}"
+        );
+        assert_eq!(chosen.mesh, ladder.mesh);
+        if chosen != ladder {
+            relaxed += 1;
+            // Newton at the coarsest rung's tolerance: the scene's 1e-8 (below target / 10)
+            assert_eq!(chosen.newton, 1e-8);
+            let est = s.runs[c.run].error().unwrap();
+            assert!(est * s.margin <= target, "estimated {est:.3e}");
+        }
+        let t = truth[c.run].unwrap();
+        assert!(t <= target, "target {target:e}: true error {t:.3e}");
+        println!(
+            "target {target:e}: h = {:e} (ladder {:e}), Newton {:e}, true {t:.2e}",
+            chosen.step, ladder.step, chosen.newton
+        );
+    }
+    assert!(relaxed >= 1, "no choice relaxed");
+}
+
+/// Where every count halves (4 elements), the mesh ladder also runs the halved mesh: not in
+/// the extrapolation, a candidate whose estimate (its distance to the limit) is within 3× of
+/// the truth; 3 elements do not halve, and no such run is made.
+#[test]
+fn the_mesh_ladder_also_runs_a_halved_mesh_where_every_count_halves() {
+    let (s, truth) = study("halved", 1e-3);
+    let i = s
+        .runs
+        .iter()
+        .position(|r| r.role == accuracy::Role::Mesh && r.setting.mesh == -1)
+        .expect("a halved mesh");
+    assert_eq!(s.meshes[0], "beam 2 el.");
+    let (est, t) = (s.runs[i].error().unwrap(), truth[i].unwrap());
+    // measured: 2 elements at 2 ms, estimated 1.48e-2, true 1.50e-2
+    assert!((1.0 / 3.0..=3.0).contains(&(est / t)), "{est:.3e} {t:.3e}");
+    assert!(s.mesh_shares.len() >= 4, "{:?}", s.mesh_shares);
+
+    let path = write_scene(
+        "odd",
+        &scene_text(BETA).replace("elements = 4", "elements = 3"),
+    );
+    let mut o = Options::new(vec!["beam.tip.deflection".into()], 1e-3);
+    o.step = Some(4e-3);
+    let odd = accuracy::study(&path, &o).unwrap();
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    assert!(odd.runs.iter().all(|r| r.setting.mesh >= 0));
+}
+
 /// The exact tip deflection as a reference CSV beside the scene.
 fn write_reference(scene: &std::path::Path) -> PathBuf {
     let times: Vec<f64> = (0..=TIMES).map(|k| k as f64 * 1e-3).collect();
@@ -257,7 +317,9 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
     assert!(rows[0].ends_with(",estimated_error,error_beam.tip.deflection,true_error"));
     // 5 steps, 2 more meshes, the chosen setting (unless a ladder ran it), the finer check,
     // Newton and stiffening (which setting is chosen rests on the runs' measured cost)
-    assert!((1 + 9..=1 + 11).contains(&rows.len()), "{csv}");
+    // (and the relaxed setting, where the ladder's was relaxed or the relaxed run missed, and
+    // the halved mesh: 2 elements)
+    assert!((1 + 10..=1 + 13).contains(&rows.len()), "{csv}");
     let first: Vec<&str> = rows[1].split(',').collect();
     assert_eq!(&first[..4], ["1", "time", "4e-3", "1e-8"]);
     let est: f64 = first[9].parse().unwrap();
@@ -265,6 +327,11 @@ fn the_command_writes_the_table_the_csv_and_the_chart() {
     // the exact series, written to 6 digits: the true error of the 4 ms step, 1.425e-3
     let truth: f64 = first[11].parse().unwrap();
     assert!((truth - 1.425e-3).abs() < 0.01e-3, "{truth}");
+    // the scene at the chosen setting, to run as it is (and for `fmu-bench choice`)
+    assert!(stdout.contains("chosen.toml"), "{stdout}");
+    let chosen = fmu_beam::Scene::load(&dir.join("chosen.toml")).unwrap();
+    assert!(!chosen.solver.adaptive);
+    assert!(chosen.solver.max_step <= 4e-3);
     let png = std::fs::read(dir.join("accuracy.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert_eq!(&png[16..24], [0, 0, 2, 208, 0, 0, 1, 224], "720 × 480");

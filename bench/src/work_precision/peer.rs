@@ -274,6 +274,24 @@ fn setting_name(setting: Setting, newton: Option<f64>) -> String {
     }
 }
 
+/// A setting as [`setting_name`] writes it, read back: the integrator setting, and a fixed
+/// step's Newton tolerance where it is not the scene's.
+pub(super) fn parse_setting(name: &str) -> Option<(Setting, Option<f64>)> {
+    let (family, size) = family(name)?;
+    match family.as_str() {
+        "tolerance" => Some((Setting::Tolerance(size), None)),
+        "fixed step" => Some((Setting::FixedStep(size), None)),
+        f => {
+            let t = f
+                .strip_prefix("fixed step, tolerance ")?
+                .trim()
+                .parse()
+                .ok()?;
+            Some((Setting::FixedStep(size), Some(t)))
+        }
+    }
+}
+
 /// The scene of a formulation at a setting. A fixed step runs Newton at `newton`, or at the
 /// scene's tolerance without it ([`FIXED_STEP_TOLERANCES`]); error control keeps the scene's
 /// largest step.
@@ -308,7 +326,7 @@ pub(super) fn configure(
 
 /// Runs `scene` over the case's grid; values per output of the case, and the counters: steps,
 /// Newton iterations, iteration matrices.
-fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
+pub(super) fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
     simulate_engine(scene, case).map(|(series, _)| series)
 }
 
@@ -572,7 +590,7 @@ fn meets(points: &[PeerPoint], p: &PeerPoint, target: f64) -> bool {
 
 /// The cheapest point (median CPU) meeting `target` for good ([`meets`]), among those of
 /// `tool` for (case, output).
-fn cheapest<'a>(
+pub(super) fn cheapest<'a>(
     points: &'a [PeerPoint],
     tool: &str,
     case: &str,
@@ -868,6 +886,19 @@ mod tests {
             seconds: [cpu; 3],
             steps: 0,
         }
+    }
+
+    #[test]
+    fn setting_names_read_back() {
+        for (setting, newton) in [
+            (Setting::FixedStep(2e-5), None),
+            (Setting::FixedStep(1e-3), Some(1e-8)),
+            (Setting::Tolerance(1e-6), None),
+        ] {
+            let back = parse_setting(&setting_name(setting, newton));
+            assert_eq!(back, Some((setting, newton)));
+        }
+        assert_eq!(parse_setting("ne=16;h=5e-05;rho_inf=0.9"), None);
     }
 
     #[test]

@@ -9,7 +9,14 @@
 //! mesh) whose predicted error (its time and mesh errors added over time) times a safety
 //! factor meets the target is run, checked against a run refined in both,
 //! and probed for Newton's share and for the geometric stiffening's (a choice of physics).
-//! [`report`] writes the table, [`plot`] the work-precision chart.
+//! Before it runs, the choice is relaxed (a larger step up to the coarser rung, at the coarsest
+//! rung's Newton tolerance) where that run's own estimate meets the target; where every count
+//! halves, the mesh ladder also offers the halved mesh. [`report`] writes the table, [`plot`]
+//! the work-precision chart.
+//!
+//! Over 600 lines: the study is one sequence (ladders, limit, choice, its relaxation, checks)
+//! whose steps share the runs and their estimates; split, each part would take most of them as
+//! arguments.
 
 pub mod estimate;
 mod options;
@@ -21,7 +28,7 @@ pub mod truth;
 use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
 use fmu_beam::{Engine, Scene, VarType};
 pub use options::{AccuracyError, Options};
-use runner::{fine_end, mesh_text, refinable, Grid, Runner};
+use runner::{coarsenable, fine_end, mesh_text, refinable, scene_at, Grid, Runner};
 use std::path::Path;
 use std::time::Instant;
 
@@ -78,8 +85,9 @@ pub struct Setting {
     pub step: f64,
     /// Newton's tolerance.
     pub newton: f64,
-    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh.
-    pub mesh: u32,
+    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh (−1: halved, where
+    /// every count is even).
+    pub mesh: i32,
     /// Every flexible beam's geometric stiffening switched.
     pub stiffening_switched: bool,
 }
@@ -118,6 +126,9 @@ impl Run {
 #[derive(Debug, Clone)]
 pub struct Choice {
     pub setting: Setting,
+    /// The ladder's setting it was relaxed from (a larger step, up to the coarser rung, and
+    /// the coarsest rung's Newton tolerance), or the same where the relaxed run missed.
+    pub ladder: Setting,
     /// Before the run: the norm of its time error (at the scene's mesh) plus its mesh error
     /// (at the mesh ladder's step), added as functions of time (they may cancel; their norms'
     /// sum, `time_share + mesh_share`, bounds it).
@@ -136,6 +147,8 @@ pub struct Choice {
     pub newton_share: Option<f64>,
     /// The difference when geometric stiffening is switched (or why it could not be).
     pub stiffening_change: Option<Result<f64, String>>,
+    /// The scene at the chosen setting, as TOML (the command writes it as `chosen.toml`).
+    pub scene_toml: String,
 }
 
 /// A finished study.
@@ -147,7 +160,7 @@ pub struct Study {
     pub start: f64,
     pub stop: f64,
     pub comm: f64,
-    /// The mesh of each level, as text (`beam 10 el.`).
+    /// The mesh of each level from −1 (halved) up, as text (`beam 10 el.`).
     pub meshes: Vec<String>,
     pub runs: Vec<Run>,
     pub time: Option<Ladder>,
@@ -157,7 +170,7 @@ pub struct Study {
     /// The choice's predicted error times this meets the target ([`SAFETY_OBSERVED`],
     /// [`SAFETY_ASSUMED`]).
     pub margin: f64,
-    /// Per time level and per mesh level: the estimated shares.
+    /// Per time level and per mesh level (from the coarsest that ran): the estimated shares.
     pub time_shares: Vec<Option<f64>>,
     pub mesh_shares: Vec<Option<f64>>,
     pub choice: Option<Choice>,
@@ -242,6 +255,12 @@ fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -
         .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
 }
 
+/// `x` rounded down to three significant digits (a step a scene can carry as written).
+fn three_digits_down(x: f64) -> f64 {
+    let m = 10f64.powi(2 - x.log10().floor() as i32);
+    (x * m).floor() / m
+}
+
 /// Runs the study of `scene_path`.
 pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessError> {
     opts.check()?;
@@ -322,7 +341,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         notes: Vec::new(),
         bar,
     };
-    let at = |level: usize, mesh: u32| Setting {
+    let at = |level: usize, mesh: i32| Setting {
         step: h0 / 2f64.powi(level as i32),
         newton: (tol0 / NEWTON_PER_HALVING.powi(level as i32)).max(1e-14),
         mesh,
@@ -392,7 +411,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             {
                 break;
             }
-            let i = r.run(Role::Mesh, at(mesh_level, j as u32), 2.5 * cost);
+            let i = r.run(Role::Mesh, at(mesh_level, j as i32), 2.5 * cost);
             if let Some(i) = i {
                 cost = r.runs[i].seconds;
             }
@@ -406,10 +425,23 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     let mesh = mesh_estimate.as_ref().and_then(|e| e.ladder.clone());
     // the limit: the mesh ladder's, moved by the time ladder's correction at its step
     let base_at_mesh_step = time_runs[mesh_level].and_then(|i| r.values(i)).cloned();
-    let (limit, mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
+    let (limit, mut mesh_shares) = match (&mesh, &mesh_estimate, &base_at_mesh_step) {
         (Some(m), Some(e), Some(b)) => (shifted(&m.limit, &time_limit, b), e.shares.clone()),
         _ => (time_limit.clone(), vec![Some(0.0)]),
     };
+    // a halved mesh, where every count is even: not in the extrapolation, a candidate whose
+    // share is its distance to the mesh ladder's limit (the scene's mesh may be finer than the
+    // target needs); `offset` is the scene's mesh's index in `mesh_runs`
+    let mut offset = 0;
+    if let (Some(e), true) = (&mesh_estimate, mesh.is_some() && coarsenable(&base)) {
+        let cost = mesh_runs[0].map_or(0.0, |i| r.runs[i].seconds) / 2.0;
+        if let Some(i) = r.run(Role::Mesh, at(mesh_level, -1), cost) {
+            let share = r.values(i).map(|y| distance(y, &e.limit, &peaks));
+            mesh_runs.insert(0, Some(i));
+            mesh_shares.insert(0, share);
+            offset = 1;
+        }
+    }
     if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
         r.notes.push(
             "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
@@ -423,7 +455,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     // the choice: the cheapest (step, mesh) whose predicted error meets the target
     let cost_of = |k: usize, j: usize, r: &Runner| -> Option<f64> {
         let c = r.runs[time_runs[k]?].seconds;
-        let m0 = r.runs[mesh_runs[0]?].seconds;
+        let m0 = r.runs[mesh_runs[offset]?].seconds;
         let mj = r.runs[(*mesh_runs.get(j)?)?].seconds;
         Some(c * mj / m0.max(1e-9))
     };
@@ -475,16 +507,67 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             }
         }
     }
+    let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
+    let p_time = order(&time, TIME_ORDER);
     let mut choice = None;
-    if let Some((k, j, predicted, predicted_seconds)) = best {
-        let setting = at(k, j as u32);
+    if let Some((k, j, ladder_predicted, ladder_seconds)) = best {
+        let ladder_setting = at(k, j as i32 - offset as i32);
+        // relaxed: the largest step up to the coarser rung (quarter octaves) that the time
+        // ladder's order predicts to meet, at Newton's tolerance of the coarsest rung (the
+        // ladder's tighter ones are for its differences); kept only if its run's estimated
+        // error (its distance to the limit, which holds its Newton error) meets the target
+        let stretch = (0..4)
+            .rev()
+            .map(|i| 2f64.powf(f64::from(i) / 4.0))
+            .filter(|&s| k > 0 || s == 1.0)
+            .find_map(|s| {
+                let e = error_of(k, j, s.powf(p_time), 1.0, &r)?;
+                let d = distance(&e, &zero, &peaks);
+                (d * margin <= opts.target).then_some((s, d))
+            });
+        let mut picked = (ladder_setting, 1.0, ladder_predicted, ladder_seconds);
+        if let Some((s, d)) = stretch {
+            let relaxed = Setting {
+                step: if s > 1.0 {
+                    three_digits_down(ladder_setting.step * s)
+                } else {
+                    ladder_setting.step
+                },
+                newton: tol0,
+                ..ladder_setting
+            };
+            if relaxed != ladder_setting {
+                let seconds = ladder_seconds / s;
+                let kept = r.run(Role::Chosen, relaxed, seconds).and_then(|i| {
+                    let e = distance(r.values(i)?, &limit, &peaks);
+                    if e * margin <= opts.target {
+                        Some(i)
+                    } else {
+                        r.notes.push(format!(
+                            "relaxed setting h = {:e} s, Newton's tolerance {:.0e}: estimated                              error {e:.2e} × {margin} misses the target; the ladder's setting                              h = {:e} s, tolerance {:.0e} kept",
+                            relaxed.step, relaxed.newton, ladder_setting.step, ladder_setting.newton
+                        ));
+                        None
+                    }
+                });
+                if kept.is_some() {
+                    picked = (relaxed, s, d, seconds);
+                }
+            }
+        }
+        let (setting, s, predicted, predicted_seconds) = picked;
         let existing = r
             .runs
             .iter()
             .position(|x| x.setting == setting && x.result.is_ok());
         let run = existing.or_else(|| r.run(Role::Chosen, setting, predicted_seconds));
         if let Some(run) = run.filter(|&i| r.values(i).is_some()) {
-            let finer_setting = at(k + 1, j as u32 + u32::from(has_mesh));
+            let finer_setting = Setting {
+                step: setting.step / 2.0,
+                newton: (setting.newton / NEWTON_PER_HALVING).max(1e-14),
+                mesh: setting.mesh + i32::from(has_mesh),
+                stiffening_switched: false,
+            };
             let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
             // a ladder's run at that setting serves (C4: the mesh ladder ran at the step above)
             let finer = r
@@ -529,11 +612,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
                 None
             };
             // the finer run has each error divided by 2^order: the difference to expect
-            let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
             let expected_difference = error_of(
                 k,
                 j,
-                1.0 - 0.5f64.powf(order(&time, TIME_ORDER)),
+                s.powf(p_time) * (1.0 - 0.5f64.powf(p_time)),
                 if has_mesh {
                     1.0 - 0.5f64.powf(order(&mesh, MESH_ORDER))
                 } else {
@@ -544,15 +626,19 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
             .map_or(f64::NAN, |e| distance(&e, &zero, &peaks));
             choice = Some(Choice {
                 setting,
+                ladder: ladder_setting,
                 predicted,
                 expected_difference,
-                time_share: time_shares[k].unwrap_or(0.0),
+                time_share: time_shares[k].unwrap_or(0.0) * s.powf(p_time),
                 mesh_share: mesh_shares[j].unwrap_or(0.0),
                 predicted_seconds,
                 run,
                 finer,
                 newton_share,
                 stiffening_change,
+                scene_toml: scene_at(&base, &setting)
+                    .map(|s| s.to_toml_string())
+                    .unwrap_or_default(),
             });
         }
     }
@@ -572,7 +658,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         start,
         stop: start + n as f64 * comm,
         comm,
-        meshes: (0..=MAX_MESH_LEVELS as u32)
+        meshes: (-1..=MAX_MESH_LEVELS as i32)
             .map(|j| mesh_text(&base, j))
             .collect(),
         runs: r.runs,

@@ -54,7 +54,7 @@ pub fn csv(study: &Study) -> String {
 fn mesh_of(study: &Study, r: &Run) -> String {
     study
         .meshes
-        .get(r.setting.mesh as usize)
+        .get((r.setting.mesh + 1).max(0) as usize)
         .cloned()
         .unwrap_or_default()
 }
@@ -222,6 +222,16 @@ pub fn markdown(study: &Study) -> String {
                 c.setting.newton,
                 mesh_of(study, run)
             );
+            if c.setting != c.ladder {
+                let _ = writeln!(
+                    s,
+                    "Relaxed from the ladder's setting (h = {:e} s, Newton's tolerance {:.0e}): \
+                     the largest step up to the coarser rung that the time ladder's order \
+                     predicts to meet, at the coarsest rung's Newton tolerance; kept because \
+                     its run's estimated error times {} meets the target.\n",
+                    c.ladder.step, c.ladder.newton, study.margin
+                );
+            }
             let _ = writeln!(s, "## How sure\n");
             match c.finer {
                 Some((i, d)) => {

@@ -29,23 +29,45 @@ pub(super) fn scene_at(base: &Scene, s: &Setting) -> Result<Scene, String> {
     sc.solver.adaptive = false;
     sc.solver.max_step = s.step;
     sc.solver.tolerance = s.newton;
-    let f = 1usize << s.mesh;
     for b in sc.beams.iter_mut().filter(|b| refinable(b)) {
         match b.substructures {
-            Some(k) => b.substructures = Some(k * f),
-            None => b.elements = Some(b.elements.unwrap_or(1) * f),
+            Some(k) => b.substructures = Some(scaled(k, s.mesh)?),
+            None => b.elements = Some(scaled(b.elements.unwrap_or(1), s.mesh)?),
         }
         if s.stiffening_switched {
             b.geometric_stiffening = !b.geometric_stiffening;
         }
     }
-    let origin = format!("{} (h = {:e} s, mesh × {f})", base.name, s.step);
+    let origin = format!("{} (h = {:e} s, mesh × 2^{})", base.name, s.step, s.mesh);
     Scene::from_toml_str(&sc.to_toml_string(), &origin).map_err(|e| e.to_string())
 }
 
+/// A count × 2^mesh (halved where `mesh` is −1: only an even count).
+fn scaled(count: usize, mesh: i32) -> Result<usize, String> {
+    if mesh >= 0 {
+        Ok(count << mesh)
+    } else if count.is_multiple_of(1 << -mesh) {
+        Ok(count >> -mesh)
+    } else {
+        Err(format!(
+            "{count} elements or substructures cannot be halved"
+        ))
+    }
+}
+
+/// Whether every flexible beam's count (elements or substructures) halves: the mesh ladder
+/// then also runs a mesh coarser than the scene's.
+pub(super) fn coarsenable(base: &Scene) -> bool {
+    let mut beams = base.beams.iter().filter(|b| refinable(b)).peekable();
+    beams.peek().is_some()
+        && beams.all(|b| {
+            let count = b.substructures.unwrap_or(b.elements.unwrap_or(1));
+            count.is_multiple_of(2)
+        })
+}
+
 /// The mesh of a scene at `mesh`, as text.
-pub(super) fn mesh_text(base: &Scene, mesh: u32) -> String {
-    let f = 1usize << mesh;
+pub(super) fn mesh_text(base: &Scene, mesh: i32) -> String {
     let parts: Vec<String> = base
         .beams
         .iter()
@@ -54,10 +76,14 @@ pub(super) fn mesh_text(base: &Scene, mesh: u32) -> String {
             Some(k) => format!(
                 "{} {}×{}",
                 b.name,
-                k * f,
+                scaled(k, mesh).unwrap_or(0),
                 b.elements_per_substructure.unwrap_or(1)
             ),
-            None => format!("{} {} el.", b.name, b.elements.unwrap_or(1) * f),
+            None => format!(
+                "{} {} el.",
+                b.name,
+                scaled(b.elements.unwrap_or(1), mesh).unwrap_or(0)
+            ),
         })
         .collect();
     if parts.is_empty() {

@@ -95,12 +95,20 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
     let png = dir.join("accuracy.png");
     std::fs::write(&png, accuracy::plot::png(&study))
         .map_err(|e| HarnessError::io(&png, "writing the chart", e))?;
+    let mut wrote = format!("{} and {}", csv.display(), png.display());
+    if let Some(c) = &study.choice {
+        let chosen = dir.join("chosen.toml");
+        std::fs::write(&chosen, &c.scene_toml)
+            .map_err(|e| HarnessError::io(&chosen, "writing the chosen scene", e))?;
+        wrote = format!(
+            "{}, {wrote} (the scene at the chosen setting)",
+            chosen.display()
+        );
+    }
     write!(
         out,
-        "{}\nWrote {} and {}.\n",
-        accuracy::report::markdown(&study),
-        csv.display(),
-        png.display()
+        "{}\nWrote {wrote}.\n",
+        accuracy::report::markdown(&study)
     )
     .map_err(stdout_err)
 }
