@@ -88,6 +88,10 @@ def run_chunk(fmu_bytes, points, stop, step):
             if i:
                 fmu.reset()
             fmu.setReal([vr["hub.drive.omega"], vr["beam.E"]], [omega, e])
+            # error control at 1e-6: each (omega, E) spins the beam differently, and the scene's
+            # fixed step was tuned for the shipped omega and E alone (issue 34)
+            fmu.setBoolean([vr["solver.adaptive"]], [True])
+            fmu.setReal([vr["solver.max_step"], vr["solver.tolerance"]], [5e-2, 1e-6])
             fmu.setupExperiment(startTime=0.0)
             fmu.enterInitializationMode()
             fmu.exitInitializationMode()
