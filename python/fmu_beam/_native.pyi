@@ -81,7 +81,8 @@ class Scene:
         """The scene as nested dicts and lists, every default written out;
         ``Scene.from_dict(s.to_dict()) == s``."""
     def explain(self) -> str:
-        """The effects the unit simulates, why, and their estimated share of the cost."""
+        """The accuracy the scene was tuned for (its ``[accuracy]``, if any), then the effects
+        the unit simulates, why, and their estimated share of the cost."""
     def modes(self, count: Optional[int] = None) -> List[float]:
         """The linearized elastic natural frequencies in Hz, ascending (rigid-body modes left
         out), at most ``count`` of them."""

@@ -126,11 +126,24 @@ impl PyScene {
         })
     }
 
-    /// The effects the unit simulates, why, and their estimated share of the cost (the text of
-    /// `fmu-beam explain` and of the FMU's documentation).
+    /// The accuracy the scene was tuned for (its `[accuracy]`, if any), then the effects the
+    /// unit simulates, why, and their estimated share of the cost (the text of `fmu-beam
+    /// explain` and of the FMU's documentation).
     fn explain(&self, py: Python<'_>) -> PyResult<String> {
         detached(py, || {
-            Ok(fmu_beam::resolve_effects(&self.scene).explain(&self.scene))
+            let table = fmu_beam::VariableTable::build(&self.scene);
+            let accuracy = fmu_beam::explain_accuracy(&self.scene, &table).map_err(|message| {
+                HarnessError::AccuracyStatement {
+                    scene: self.scene.name.clone(),
+                    message,
+                }
+            })?;
+            let effects = fmu_beam::resolve_effects(&self.scene).explain(&self.scene);
+            Ok(if accuracy.is_empty() {
+                effects
+            } else {
+                format!("{accuracy}\n{effects}")
+            })
         })
     }
 

@@ -547,7 +547,10 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
                             "relaxed setting h = {:e} s, Newton's tolerance {:.0e}: estimated \
                              error {e:.2e} × {margin} misses the target; \
                              the ladder's setting h = {:e} s, tolerance {:.0e} kept",
-                            relaxed.step, relaxed.newton, ladder_setting.step, ladder_setting.newton
+                            relaxed.step,
+                            relaxed.newton,
+                            ladder_setting.step,
+                            ladder_setting.newton
                         ));
                         None
                     }
