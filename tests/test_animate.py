@@ -60,7 +60,9 @@ def animate(harness, run, name, *extra):
 
 @pytest.fixture(scope="module")
 def c3(harness, fmu_dir):
-    return animate(harness, fmu_dir / "slider_crank.fmu", "slider_crank", "--speed", "0.25")
+    # 1 ms frames, as the tests below count them (the scene's own communication step is 10 ms)
+    return animate(harness, fmu_dir / "slider_crank.fmu", "slider_crank", "--speed", "0.25",
+                   "--step", "1e-3")
 
 
 @pytest.fixture(scope="module")
