@@ -61,7 +61,10 @@ CASES = [
 ]
 FIXED_RTOL = 0.1
 ADAPTIVE_RTOL = 10.0
-FLOOR = 1e-6
+# an output below 1e-4 of the largest of its unit is zero by the physics: C3's rod tip held on
+# the slide line (3.7e-7 m against 0.37 m) differed by 7e-16 m between the platforms after a
+# state restore, round-off that a floor of 1e-6 made 1.9e-9 "relative" at its fixed step
+FLOOR = 1e-4
 
 
 def bits(hex16):
