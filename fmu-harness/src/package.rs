@@ -117,15 +117,9 @@ pub fn contents(
 fn documentation(scene: &Scene, table: &VariableTable) -> Result<String, HarnessError> {
     let effects = fmu_beam::resolve_effects(scene).explain(scene);
     let feedthrough = fmu_beam::explain_feedthrough(scene, table);
-    let accuracy = match fmu_beam::explain_accuracy(scene, table) {
-        Ok(text) if text.is_empty() => String::new(),
-        Ok(text) => format!("<p>{}</p>\n", escape(&text)),
-        Err(message) => {
-            return Err(HarnessError::AccuracyStatement {
-                scene: scene.name.clone(),
-                message,
-            })
-        }
+    let accuracy = match accuracy_statement(scene, table)? {
+        text if text.is_empty() => String::new(),
+        text => format!("<p>{}</p>\n", escape(&text)),
     };
     Ok(format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\n{STYLE}</head>\n\
@@ -139,6 +133,27 @@ fn documentation(scene: &Scene, table: &VariableTable) -> Result<String, Harness
         effects = escape(&effects),
         feedthrough = escape(&feedthrough),
     ))
+}
+
+/// The scene's `[accuracy]` statement (empty without one); refused where its output is not a
+/// Real output of the unit.
+fn accuracy_statement(scene: &Scene, table: &VariableTable) -> Result<String, HarnessError> {
+    fmu_beam::explain_accuracy(scene, table).map_err(|message| HarnessError::AccuracyStatement {
+        scene: scene.name.clone(),
+        message,
+    })
+}
+
+/// What `explain` prints (the command and the Python package's `Scene.explain()`): the
+/// accuracy the scene was tuned for, then its effects, why, and their share of the cost.
+pub fn explain(scene: &Scene) -> Result<String, HarnessError> {
+    let accuracy = accuracy_statement(scene, &VariableTable::build(scene))?;
+    let effects = fmu_beam::resolve_effects(scene).explain(scene);
+    Ok(if accuracy.is_empty() {
+        effects
+    } else {
+        format!("{accuracy}\n{effects}")
+    })
 }
 
 const STYLE: &str = "<style>table{border-collapse:collapse}td,th{border:1px solid #ccc;\

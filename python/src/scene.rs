@@ -130,21 +130,7 @@ impl PyScene {
     /// unit simulates, why, and their estimated share of the cost (the text of `fmu-beam
     /// explain` and of the FMU's documentation).
     fn explain(&self, py: Python<'_>) -> PyResult<String> {
-        detached(py, || {
-            let table = fmu_beam::VariableTable::build(&self.scene);
-            let accuracy = fmu_beam::explain_accuracy(&self.scene, &table).map_err(|message| {
-                HarnessError::AccuracyStatement {
-                    scene: self.scene.name.clone(),
-                    message,
-                }
-            })?;
-            let effects = fmu_beam::resolve_effects(&self.scene).explain(&self.scene);
-            Ok(if accuracy.is_empty() {
-                effects
-            } else {
-                format!("{accuracy}\n{effects}")
-            })
-        })
+        detached(py, || fmu_harness::package::explain(&self.scene))
     }
 
     /// The linearized elastic natural frequencies in Hz, ascending (rigid-body modes left

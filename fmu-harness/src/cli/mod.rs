@@ -545,20 +545,7 @@ fn animate_recording(
 /// `explain`: the accuracy the scene was tuned for, its effects, why, and their share of the
 /// cost.
 fn explain_cmd(scene: &Path, out: &mut dyn Write) -> Result<(), HarnessError> {
-    let scene = fmu_beam::Scene::load(scene)?;
-    let table = fmu_beam::VariableTable::build(&scene);
-    let accuracy = fmu_beam::explain_accuracy(&scene, &table).map_err(|message| {
-        HarnessError::AccuracyStatement {
-            scene: scene.name.clone(),
-            message,
-        }
-    })?;
-    let effects = fmu_beam::resolve_effects(&scene).explain(&scene);
-    let text = if accuracy.is_empty() {
-        effects
-    } else {
-        format!("{accuracy}\n{effects}")
-    };
+    let text = crate::package::explain(&fmu_beam::Scene::load(scene)?)?;
     out.write_all(text.as_bytes()).map_err(stdout_err)
 }
 
