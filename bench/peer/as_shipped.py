@@ -34,9 +34,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import exudyn_cases as ec  # noqa: E402
+from sweep import load_reference, parse_setting  # noqa: E402
 
 ROOT = os.path.normpath(os.path.join(HERE, '..', '..'))
-REF_DIR = os.path.join(ROOT, 'bench', 'reference')
 OUT_DIR = os.path.join(ROOT, 'build', 'bench')
 
 # (scene, peer case, [(reference column, how to read it from an fmpy result)]): the outputs the
@@ -81,26 +81,9 @@ def score(result, how, ref, column):
     return float(np.max(np.abs(y - y_ref)) / np.max(np.abs(ref[column])))
 
 
-def load_reference(case):
-    data = np.genfromtxt(os.path.join(REF_DIR, case + '.csv'), delimiter=',', names=True)
-    return {n: np.asarray(data[n]) for n in data.dtype.names}
-
-
 def peer_points(path):
     with open(path, newline='') as f:
         return [r for r in csv.DictReader(f) if r['tool'] == 'exudyn']
-
-
-def parse_setting(text):
-    """`ne=8;h=0.00025;rho_inf=0.9` or `ne_rod=4,ne_crank=2;h=...` -> run() arguments."""
-    mesh, h, rho = text.split(';')
-    args = dict(step=float(h.split('=')[1]), spectral_radius=float(rho.split('=')[1]))
-    fields = dict(kv.split('=') for kv in mesh.split(','))
-    args['ne'] = int(fields.get('ne', fields.get('ne_rod')))
-    crank = fields.get('ne_crank')
-    if crank not in (None, 'rigid'):
-        args['ne_crank'] = int(crank)
-    return args
 
 
 def cheapest_peer(points, case, column, error):

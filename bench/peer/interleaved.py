@@ -37,6 +37,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import exudyn_cases as ec  # noqa: E402
+import sweep  # noqa: E402
 
 ROOT = os.path.normpath(os.path.join(HERE, '..', '..'))
 BENCH = os.path.join(ROOT, 'build', 'bench')
@@ -131,9 +132,8 @@ def peer_md_choices(path):
 
 
 def exudyn_args(case, setting):
-    fields = dict(f.split('=', 1) for f in setting.replace(',', ';').split(';'))
-    ne = int(fields.get('ne', fields.get('ne_rod')))
-    return ne, float(fields['h']), float(fields['rho_inf'])
+    a = sweep.parse_setting(setting)
+    return a['ne'], a['step'], a['spectral_radius']
 
 
 def run_ours(case, formulation, setting):

@@ -70,6 +70,17 @@ def setting_name(case, ne, h, rho):
     return '%s;h=%g;rho_inf=%g' % (ne_txt, h, rho)
 
 
+def parse_setting(text):
+    """The run() arguments of a setting name (`setting_name`'s inverse): `ne=8;h=0.00025;rho_inf=0.9`
+    or `ne_rod=4,ne_crank=2;h=...` (a rigid crank is the case's)."""
+    fields = dict(f.split('=', 1) for f in text.replace(',', ';').split(';'))
+    args = dict(ne=int(fields.get('ne', fields.get('ne_rod'))), step=float(fields['h']),
+                spectral_radius=float(fields['rho_inf']))
+    if fields.get('ne_crank', 'rigid') != 'rigid':
+        args['ne_crank'] = int(fields['ne_crank'])
+    return args
+
+
 def measure(case, ne, h, rho):
     cpus, steps, res = [], None, None
     for k in range(REPEATS):
