@@ -3,16 +3,17 @@
 //! with the Newton tolerance divided by 4 at each halving, so that Newton's error falls as fast
 //! as the step's), then a mesh ladder (every flexible beam's elements, or substructures where it
 //! has them, doubled) at one step of the time ladder; each goes on past its asked length while
-//! none of its runs is within half the target. Each run's error on the chosen outputs is
-//! estimated from the runs themselves ([`estimate`]): Richardson's extrapolation of each ladder
-//! with its observed order, the two corrections added to one limit. The cheapest pair (step,
-//! mesh) whose predicted error (its time and mesh errors added over time) times a safety
-//! factor meets the target is run, checked against a run refined in both,
-//! and probed for Newton's share and for the geometric stiffening's (a choice of physics).
-//! Before it runs, the choice is relaxed (a larger step up to the coarser rung, at the coarsest
-//! rung's Newton tolerance) where that run's own estimate meets the target; where every count
-//! halves, the mesh ladder also offers the halved mesh. [`report`] writes the table, [`plot`]
-//! the work-precision chart.
+//! none of its runs is within half the target, or while its observed order is implausible (not
+//! in the asymptotic range) and its finest difference above a tenth of the target. Each run's
+//! error on the chosen outputs is estimated from the runs themselves ([`estimate`]):
+//! Richardson's extrapolation of each ladder with its observed order, the two corrections added
+//! to one limit. The cheapest pair (step, mesh) whose predicted error (its time and mesh errors
+//! added over time) times a safety factor meets the target is run, checked against a run
+//! refined in both, and probed for Newton's share and for the geometric stiffening's (a choice
+//! of physics). Before it runs, the choice is relaxed (a larger step up to the coarser rung, at
+//! the coarsest rung's Newton tolerance) where that run's own estimate meets the target; the
+//! mesh ladder also offers the halved mesh (each count halved, rounded up). [`report`] writes
+//! the table, [`plot`] the work-precision chart.
 //!
 //! Over 600 lines: the study is one sequence (ladders, limit, choice, its relaxation, checks)
 //! whose steps share the runs and their estimates; split, each part would take most of them as
@@ -85,8 +86,8 @@ pub struct Setting {
     pub step: f64,
     /// Newton's tolerance.
     pub newton: f64,
-    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh (−1: halved, where
-    /// every count is even).
+    /// The mesh: each flexible beam's elements (or substructures) × 2^mesh (−1: halved,
+    /// rounded up).
     pub mesh: i32,
     /// Every flexible beam's geometric stiffening switched.
     pub stiffening_switched: bool,
@@ -255,6 +256,26 @@ fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -
         .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
 }
 
+/// Whether a ladder of three runs or more is out of its asymptotic range (its observed order
+/// implausible) while its finest difference is above `bound`: its estimate is then unsure at
+/// the scale of the target, and refining further is what finds the range (Roache 1997).
+fn ladder_unsettled(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -> bool {
+    let Some(&finest) = fine_end(r, rungs).last() else {
+        return false;
+    };
+    let Some(pk) = r.values(finest).map(peaks) else {
+        return false;
+    };
+    estimate(r, rungs, &pk, nominal).is_some_and(|e| {
+        e.ladder.is_some_and(|l| {
+            matches!(
+                l.source,
+                estimate::OrderSource::Nominal { observed: Some(_) }
+            ) && l.differences.last().is_some_and(|&d| d > bound)
+        })
+    })
+}
+
 /// `x` rounded down to three significant digits (a step a scene can carry as written).
 fn three_digits_down(x: f64) -> f64 {
     let m = 10f64.powi(2 - x.log10().floor() as i32);
@@ -349,13 +370,15 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     };
 
     // the time ladder, coarse to fine (each halving about doubles the cost); past
-    // `opts.levels` it goes on while no step's share is within half the target
+    // `opts.levels` it goes on while no step's share is within half the target, or while its
+    // order is not observed and its finest difference is above a tenth of the target
     let mut time_runs: Vec<Option<usize>> = Vec::new();
     let mut last_cost = 0.0;
     for k in 0..MAX_TIME_LEVELS {
         if k >= opts.levels
             && (time_runs.last() == Some(&None)
-                || ladder_meets(&r, &time_runs, TIME_ORDER, opts.target / 2.0))
+                || (ladder_meets(&r, &time_runs, TIME_ORDER, opts.target / 2.0)
+                    && !ladder_unsettled(&r, &time_runs, TIME_ORDER, opts.target / 10.0)))
         {
             break;
         }
@@ -391,7 +414,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
 
     // the mesh ladder, at the coarsest step whose time share is within a quarter of the
     // target (the mesh runs are then settings the choice can take), else the finest; past
-    // `opts.mesh_levels` it goes on while no mesh's share is within half the target
+    // `opts.mesh_levels` it goes on as the time ladder does
     let has_mesh = base.beams.iter().any(refinable);
     let tail_levels: Vec<usize> = (0..time_runs.len())
         .filter(|&k| time_runs[k].is_some_and(|i| time_tail.contains(&i)))
@@ -407,7 +430,8 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         for j in 1..MAX_MESH_LEVELS {
             if j >= opts.mesh_levels
                 && (mesh_runs.last() == Some(&None)
-                    || ladder_meets(&r, &mesh_runs, MESH_ORDER, opts.target / 2.0))
+                    || (ladder_meets(&r, &mesh_runs, MESH_ORDER, opts.target / 2.0)
+                        && !ladder_unsettled(&r, &mesh_runs, MESH_ORDER, opts.target / 10.0)))
             {
                 break;
             }
@@ -429,7 +453,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
         (Some(m), Some(e), Some(b)) => (shifted(&m.limit, &time_limit, b), e.shares.clone()),
         _ => (time_limit.clone(), vec![Some(0.0)]),
     };
-    // a halved mesh, where every count is even: not in the extrapolation, a candidate whose
+    // a halved mesh (rounded up: 3 elements give 2): not in the extrapolation, a candidate whose
     // share is its distance to the mesh ladder's limit (the scene's mesh may be finer than the
     // target needs); `offset` is the scene's mesh's index in `mesh_runs`
     let mut offset = 0;

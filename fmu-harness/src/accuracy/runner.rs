@@ -42,28 +42,26 @@ pub(super) fn scene_at(base: &Scene, s: &Setting) -> Result<Scene, String> {
     Scene::from_toml_str(&sc.to_toml_string(), &origin).map_err(|e| e.to_string())
 }
 
-/// A count × 2^mesh (halved where `mesh` is −1: only an even count).
+/// A count × 2^mesh; below 0 divided by 2^−mesh, rounded up (3 elements halve into 2: the
+/// coarser mesh nearest half the scene's), never below 1.
 fn scaled(count: usize, mesh: i32) -> Result<usize, String> {
     if mesh >= 0 {
-        Ok(count << mesh)
-    } else if count.is_multiple_of(1 << -mesh) {
-        Ok(count >> -mesh)
+        count
+            .checked_shl(mesh as u32)
+            .filter(|c| c >> mesh == count)
+            .ok_or_else(|| format!("{count} elements or substructures × 2^{mesh} overflow"))
     } else {
-        Err(format!(
-            "{count} elements or substructures cannot be halved"
-        ))
+        Ok(count.div_ceil(1 << mesh.unsigned_abs().min(30)).max(1))
     }
 }
 
-/// Whether every flexible beam's count (elements or substructures) halves: the mesh ladder
-/// then also runs a mesh coarser than the scene's.
+/// Whether some flexible beam has more than one element (or substructure): the mesh ladder
+/// then also runs the halved mesh, coarser than the scene's.
 pub(super) fn coarsenable(base: &Scene) -> bool {
-    let mut beams = base.beams.iter().filter(|b| refinable(b)).peekable();
-    beams.peek().is_some()
-        && beams.all(|b| {
-            let count = b.substructures.unwrap_or(b.elements.unwrap_or(1));
-            count.is_multiple_of(2)
-        })
+    base.beams
+        .iter()
+        .filter(|b| refinable(b))
+        .any(|b| b.substructures.unwrap_or(b.elements.unwrap_or(1)) > 1)
 }
 
 /// The mesh of a scene at `mesh`, as text.
