@@ -32,11 +32,12 @@ pub struct AccuracyArgs {
     /// smaller of the scene's tolerance and target / 10].
     #[arg(long, allow_hyphen_values = true)]
     pub newton: Option<f64>,
-    /// Steps in the time ladder (each half the one before).
+    /// Steps in the time ladder (each half the one before); more where none is within half
+    /// the target, or where the observed order is implausible at the target's scale.
     #[arg(long, default_value_t = 5)]
     pub levels: usize,
     /// Meshes in the mesh ladder: the scene's, then each flexible beam's elements (or
-    /// substructures) doubled.
+    /// substructures) doubled; more as for --levels. The halved mesh (rounded up) also runs.
     #[arg(long, default_value_t = 3)]
     pub mesh_levels: usize,
     /// The study's budget: runs.
