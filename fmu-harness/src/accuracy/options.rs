@@ -58,6 +58,8 @@ pub struct Options {
     pub reference: Option<(std::path::PathBuf, Vec<String>)>,
     /// Draw a progress bar on standard error (when it is a terminal).
     pub progress: bool,
+    /// Run the study again at another mesh where that may be cheaper (`study`'s `recentred`).
+    pub recentre: bool,
 }
 
 impl Options {
@@ -76,6 +78,7 @@ impl Options {
             max_seconds: 600.0,
             reference: None,
             progress: false,
+            recentre: true,
         }
     }
 

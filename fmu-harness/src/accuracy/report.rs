@@ -303,8 +303,16 @@ pub fn markdown(study: &Study) -> String {
     }
     let _ = writeln!(
         s,
-        "## Cost\n\n{} runs, {:.2} CPU s, {:.2} s wall.",
-        study.runs.len(),
+        "## Cost\n\n{} runs{}, {:.2} CPU s, {:.2} s wall.",
+        study.runs.len() + study.earlier_runs,
+        if study.earlier_runs > 0 {
+            format!(
+                " ({} of them in the other study of the notes, not in the table)",
+                study.earlier_runs
+            )
+        } else {
+            String::new()
+        },
         study.cpu_seconds,
         study.wall_seconds
     );

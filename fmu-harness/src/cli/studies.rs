@@ -40,6 +40,10 @@ pub struct AccuracyArgs {
     /// substructures) doubled; more as for --levels. The halved mesh (rounded up) also runs.
     #[arg(long, default_value_t = 3)]
     pub mesh_levels: usize,
+    /// One study only: not run again at the chosen mesh (or the halved one) where that mesh's
+    /// own time ladder may allow a cheaper setting.
+    #[arg(long)]
+    pub no_recentre: bool,
     /// The study's budget: runs.
     #[arg(long, default_value_t = 30)]
     pub max_runs: usize,
@@ -84,6 +88,7 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
     o.max_seconds = args.max_seconds;
     o.reference = args.reference.map(|p| (p, args.columns));
     o.progress = true;
+    o.recentre = !args.no_recentre;
     let study = accuracy::study(&args.scene, &o)?;
     let dir = args
         .dir
