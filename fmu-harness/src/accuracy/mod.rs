@@ -22,6 +22,7 @@
 pub mod estimate;
 mod options;
 pub mod plot;
+mod recentre;
 pub mod report;
 mod runner;
 pub mod truth;
@@ -286,112 +287,16 @@ fn three_digits_down(x: f64) -> f64 {
 }
 
 /// Runs the study of `scene_path`; where it chooses a mesh other than the scene's, or the
-/// halved mesh could meet the target, runs it again at that mesh ([`recentred`]).
+/// halved mesh could meet the target, runs it again at that mesh ([`recentre`]).
 pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessError> {
     opts.check()?;
     let base = Scene::load(scene_path)?;
     let first = study_of(&base, opts)?;
     Ok(if opts.recentre {
-        recentred(&base, opts, first)
+        recentre::recentred(&base, opts, first, study_of)
     } else {
         first
     })
-}
-
-/// The ladders measure the step's error at the scene's mesh and add each mesh's error at one
-/// step; at another mesh the step's own error may differ (C2: a finer mesh rings less after
-/// the release, and the first study's step is smaller than its mesh needs; C3's elastic
-/// crank: 2 elements do not carry the modes 3 ring in). Where the choice is another mesh, or
-/// the halved mesh's own error times the safety factor is within the target, the study runs
-/// again with that mesh as the scene's, in what is left of the budget, and the cheaper of the
-/// two choices (each certified by its own ladders, finer run and factor) is kept, the other
-/// named in a note.
-fn recentred(base: &Scene, opts: &Options, first: Study) -> Study {
-    let Some(c) = first.choice.as_ref() else {
-        return first;
-    };
-    // the chosen mesh, else the halved one where its own error leaves room for the step's
-    let halved_fits = first.runs.iter().any(|r| {
-        r.role == Role::Mesh
-            && r.setting.mesh == -1
-            && r.error().is_some_and(|e| e * first.margin < first.target)
-    });
-    let m = match c.setting.mesh {
-        0 if halved_fits => -1,
-        0 => return first,
-        m => m,
-    };
-    let at_mesh = Setting {
-        step: base.solver.max_step,
-        newton: base.solver.tolerance,
-        mesh: m,
-        stiffening_switched: false,
-    };
-    let Ok(mut moved) = scene_at(base, &at_mesh) else {
-        return first;
-    };
-    moved.solver.adaptive = base.solver.adaptive;
-    let mut o = opts.clone();
-    o.max_runs = opts.max_runs.saturating_sub(first.runs.len());
-    o.max_seconds = opts.max_seconds - first.wall_seconds;
-    let mesh = first.meshes[(m + 1) as usize].clone();
-    let first_seconds = first.runs[c.run].seconds;
-    let said = |s: &Study| {
-        s.choice.as_ref().map_or("no choice".to_string(), |c| {
-            format!(
-                "h = {:e} s, mesh {}, estimated {:.2e}, {:.3} CPU s",
-                c.setting.step,
-                s.meshes[(c.setting.mesh + 1).max(0) as usize],
-                c.predicted,
-                s.runs[c.run].seconds
-            )
-        })
-    };
-    let second = if o.max_runs == 0 || o.max_seconds <= 0.0 {
-        Err("the budget is spent".to_string())
-    } else {
-        study_of(&moved, &o).map_err(|e| e.to_string())
-    };
-    let mut first = first;
-    match second {
-        Ok(mut second)
-            if second
-                .choice
-                .as_ref()
-                .is_some_and(|c2| second.runs[c2.run].seconds < first_seconds) =>
-        {
-            let note = format!(
-                "re-centred: the first study (at the scene's mesh, {} runs, {:.2} CPU s) chose \
-                 {}; this study, with {mesh} as the scene's mesh, chose a cheaper setting",
-                first.runs.len(),
-                first.cpu_seconds,
-                said(&first)
-            );
-            second.notes.insert(0, note);
-            second.earlier_runs = first.runs.len();
-            second.cpu_seconds += first.cpu_seconds;
-            second.wall_seconds += first.wall_seconds;
-            second
-        }
-        Ok(second) => {
-            first.earlier_runs += second.runs.len();
-            first.notes.push(format!(
-                "re-centred on {mesh} ({} runs, {:.2} CPU s): {}, not cheaper; kept",
-                second.runs.len(),
-                second.cpu_seconds,
-                said(&second)
-            ));
-            first.cpu_seconds += second.cpu_seconds;
-            first.wall_seconds += second.wall_seconds;
-            first
-        }
-        Err(e) => {
-            first
-                .notes
-                .push(format!("re-centred on {mesh}: not run ({e})"));
-            first
-        }
-    }
 }
 
 fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> {
