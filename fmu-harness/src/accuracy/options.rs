@@ -74,7 +74,7 @@ impl Options {
             newton: None,
             levels: 5,
             mesh_levels: 3,
-            max_runs: 30,
+            max_runs: 60,
             max_seconds: 600.0,
             reference: None,
             progress: false,

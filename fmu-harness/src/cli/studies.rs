@@ -44,8 +44,8 @@ pub struct AccuracyArgs {
     /// own time ladder may allow a cheaper setting.
     #[arg(long)]
     pub no_recentre: bool,
-    /// The study's budget: runs.
-    #[arg(long, default_value_t = 30)]
+    /// The study's budget: runs (both studies, where it is re-centred).
+    #[arg(long, default_value_t = 60)]
     pub max_runs: usize,
     /// The study's budget: wall seconds (a run predicted to pass it is left out and said).
     #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
