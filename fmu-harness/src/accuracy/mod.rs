@@ -187,6 +187,13 @@ pub struct Study {
 }
 
 impl Study {
+    /// The text of the mesh at `mesh` (−1: the halved one), as the table writes it.
+    pub fn mesh_name(&self, mesh: i32) -> &str {
+        self.meshes
+            .get((mesh + 1).max(0) as usize)
+            .map_or("", String::as_str)
+    }
+
     /// Whether the runs were judged against a reference.
     pub fn judged(&self) -> bool {
         self.runs.iter().any(|r| !r.true_errors.is_empty())
@@ -248,36 +255,32 @@ fn estimate(r: &Runner, rungs: &[Option<usize>], peaks: &[f64], nominal: f64) ->
     })
 }
 
-/// Whether a ladder of at least two runs has a rung whose share is within `bound`.
-fn ladder_meets(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -> bool {
+/// Whether a ladder past its asked length may stop: it has two runs or more, one of them
+/// within half the target, and it is not out of its asymptotic range (an implausible observed
+/// order) while its finest difference is above a tenth of the target: its estimate would then
+/// be unsure at the target's own scale, and refining further is what finds the range (Roache
+/// 1997).
+fn ladder_done(r: &Runner, rungs: &[Option<usize>], nominal: f64, target: f64) -> bool {
     let Some(&finest) = fine_end(r, rungs).last() else {
         return false;
     };
     let Some(pk) = r.values(finest).map(peaks) else {
         return false;
     };
-    estimate(r, rungs, &pk, nominal)
-        .is_some_and(|e| e.ladder.is_some() && e.shares.iter().flatten().any(|&s| s <= bound))
-}
-
-/// Whether a ladder of three runs or more is out of its asymptotic range (its observed order
-/// implausible) while its finest difference is above `bound`: its estimate is then unsure at
-/// the scale of the target, and refining further is what finds the range (Roache 1997).
-fn ladder_unsettled(r: &Runner, rungs: &[Option<usize>], nominal: f64, bound: f64) -> bool {
-    let Some(&finest) = fine_end(r, rungs).last() else {
+    let Some(Estimate {
+        ladder: Some(l),
+        shares,
+        ..
+    }) = estimate(r, rungs, &pk, nominal)
+    else {
         return false;
     };
-    let Some(pk) = r.values(finest).map(peaks) else {
-        return false;
-    };
-    estimate(r, rungs, &pk, nominal).is_some_and(|e| {
-        e.ladder.is_some_and(|l| {
-            matches!(
-                l.source,
-                estimate::OrderSource::Nominal { observed: Some(_) }
-            ) && l.differences.last().is_some_and(|&d| d > bound)
-        })
-    })
+    let meets = shares.iter().flatten().any(|&s| s <= target / 2.0);
+    let unsettled = matches!(
+        l.source,
+        estimate::OrderSource::Nominal { observed: Some(_) }
+    ) && l.differences.last().is_some_and(|&d| d > target / 10.0);
+    meets && !unsettled
 }
 
 /// `x` rounded down to three significant digits (a step a scene can carry as written).
@@ -392,8 +395,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
     for k in 0..MAX_TIME_LEVELS {
         if k >= opts.levels
             && (time_runs.last() == Some(&None)
-                || (ladder_meets(&r, &time_runs, TIME_ORDER, opts.target / 2.0)
-                    && !ladder_unsettled(&r, &time_runs, TIME_ORDER, opts.target / 10.0)))
+                || ladder_done(&r, &time_runs, TIME_ORDER, opts.target))
         {
             break;
         }
@@ -445,8 +447,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         for j in 1..MAX_MESH_LEVELS {
             if j >= opts.mesh_levels
                 && (mesh_runs.last() == Some(&None)
-                    || (ladder_meets(&r, &mesh_runs, MESH_ORDER, opts.target / 2.0)
-                        && !ladder_unsettled(&r, &mesh_runs, MESH_ORDER, opts.target / 10.0)))
+                    || ladder_done(&r, &mesh_runs, MESH_ORDER, opts.target))
             {
                 break;
             }

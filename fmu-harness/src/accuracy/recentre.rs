@@ -47,14 +47,14 @@ pub(super) fn recentred(
     let mut o = opts.clone();
     o.max_runs = opts.max_runs.saturating_sub(first.runs.len());
     o.max_seconds = opts.max_seconds - first.wall_seconds;
-    let mesh = first.meshes[(m + 1) as usize].clone();
+    let mesh = first.mesh_name(m).to_string();
     let first_seconds = first.runs[c.run].seconds;
     let said = |s: &Study| {
         s.choice.as_ref().map_or("no choice".to_string(), |c| {
             format!(
                 "h = {:e} s, mesh {}, estimated {:.2e}, {:.3} CPU s",
                 c.setting.step,
-                s.meshes[(c.setting.mesh + 1).max(0) as usize],
+                s.mesh_name(c.setting.mesh),
                 c.predicted,
                 s.runs[c.run].seconds
             )

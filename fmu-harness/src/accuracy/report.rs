@@ -52,11 +52,7 @@ pub fn csv(study: &Study) -> String {
 }
 
 fn mesh_of(study: &Study, r: &Run) -> String {
-    study
-        .meshes
-        .get((r.setting.mesh + 1).max(0) as usize)
-        .cloned()
-        .unwrap_or_default()
+    study.mesh_name(r.setting.mesh).to_string()
 }
 
 fn ladder_text(name: &str, l: &Option<Ladder>, nominal: f64) -> String {

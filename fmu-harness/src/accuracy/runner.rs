@@ -31,8 +31,8 @@ pub(super) fn scene_at(base: &Scene, s: &Setting) -> Result<Scene, String> {
     sc.solver.tolerance = s.newton;
     for b in sc.beams.iter_mut().filter(|b| refinable(b)) {
         match b.substructures {
-            Some(k) => b.substructures = Some(scaled(k, s.mesh)?),
-            None => b.elements = Some(scaled(b.elements.unwrap_or(1), s.mesh)?),
+            Some(k) => b.substructures = Some(scaled(k, s.mesh)),
+            None => b.elements = Some(scaled(b.elements.unwrap_or(1), s.mesh)),
         }
         if s.stiffening_switched {
             b.geometric_stiffening = !b.geometric_stiffening;
@@ -44,14 +44,11 @@ pub(super) fn scene_at(base: &Scene, s: &Setting) -> Result<Scene, String> {
 
 /// A count × 2^mesh; below 0 divided by 2^−mesh, rounded up (3 elements halve into 2: the
 /// coarser mesh nearest half the scene's), never below 1.
-fn scaled(count: usize, mesh: i32) -> Result<usize, String> {
+fn scaled(count: usize, mesh: i32) -> usize {
     if mesh >= 0 {
-        count
-            .checked_shl(mesh as u32)
-            .filter(|c| c >> mesh == count)
-            .ok_or_else(|| format!("{count} elements or substructures × 2^{mesh} overflow"))
+        count << mesh
     } else {
-        Ok(count.div_ceil(1 << mesh.unsigned_abs().min(30)).max(1))
+        count.div_ceil(1 << -mesh).max(1)
     }
 }
 
@@ -74,14 +71,10 @@ pub(super) fn mesh_text(base: &Scene, mesh: i32) -> String {
             Some(k) => format!(
                 "{} {}×{}",
                 b.name,
-                scaled(k, mesh).unwrap_or(0),
+                scaled(k, mesh),
                 b.elements_per_substructure.unwrap_or(1)
             ),
-            None => format!(
-                "{} {} el.",
-                b.name,
-                scaled(b.elements.unwrap_or(1), mesh).unwrap_or(0)
-            ),
+            None => format!("{} {} el.", b.name, scaled(b.elements.unwrap_or(1), mesh)),
         })
         .collect();
     if parts.is_empty() {
