@@ -189,11 +189,11 @@ bench: .venv release
 
 # Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
 # and steps (bench/peer/sweep.py, about 12 min), then this engine over substructures/elements and
-# steps or tolerances (fmu-bench peer, about 8 min), both scored against the exact references
-# of bench/reference; build/bench/PEER.md has the CPU time ratios at equal accuracy. Then the
-# shipped C2-C4 scenes as a user runs them (issue 34 item 3: their FMUs in fmpy with their own
-# settings, interleaved with Exudyn's cheapest run as accurate; bench/peer/as_shipped.py, about
-# 2 min): build/bench/AS_SHIPPED.md.
+# steps or tolerances (fmu-bench peer, 12 min since C2 may take 20 s a run), both scored
+# against the exact references of bench/reference; build/bench/PEER.md has the CPU time ratios
+# at equal accuracy. Then the shipped C2-C4 scenes as a user runs them (issue 34 item 3: their
+# FMUs in fmpy with their own settings, interleaved with Exudyn's cheapest run as accurate;
+# bench/peer/as_shipped.py, about 2 min): build/bench/AS_SHIPPED.md.
 VENV_BENCH  := .venv-bench
 BENCH_STAMP := $(VENV_BENCH)/.requirements.stamp
 $(BENCH_STAMP): requirements-bench.txt
@@ -217,9 +217,8 @@ bench-interleaved: $(BENCH_STAMP) release
 # The accuracy study checked against the truth (issue 34 item 2): `fmu-harness accuracy` on the
 # shipped C2-C4 scenes at targets 1e-2, 1e-3, 1e-4 with --reference bench/reference/<case>.csv,
 # each study's report in build/accuracy/<case>-<target>.md (its "Against the reference" line:
-# the chosen setting's true error and estimate / true); 8 min at a budget of 150 s per study,
-# C2 the most of it; now 450 s (C2's re-centred study at 1e-3 needs 430; C2 at 1e-4 may take
-# all of it): up to about 20 min, not timed yet. Each case
+# the chosen setting's true error and estimate / true); a budget of 450 s per study (C2's
+# re-centred study at 1e-3 needs about 380): 10 min (2026-11-29, load 1), C2 9 of it. Each case
 # names the reference's grid (--comm) and the ladders' start (--step, and Newton's tolerance
 # 1e-6): the steps the scenes had before the study tuned them (issue 34), so that the study
 # does not start from its own earlier answer.

@@ -70,7 +70,8 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// CPU seconds of one run above which the tighter settings of the same formulation
-        /// and integrator mode are skipped.
+        /// and integrator mode are skipped (a case may allow more: C2, 20 s, for the steps
+        /// its tip deflection needs).
         #[arg(long, default_value_t = 4.0)]
         budget: f64,
         /// Only these cases (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
