@@ -137,9 +137,9 @@ pub fn cases() -> Vec<PeerCase> {
                 Tol(1e-7),
                 Tol(1e-8),
             ],
-            // the tip deflection at 1e-3 is decided at 1e-5 s (20 x 2: about 6 s a run, after
-            // 2.5 s at 2e-5 s): the default 4 s stopped it at 2e-5 s, out of the comparison
-            // (the peer's sweep runs its 32 elements at 1e-5 s, 20 s)
+            // the tip deflection at 1e-3 is decided at 1e-5 s (20 x 2: 6-10 s a run, after
+            // 4-5 s at 2e-5 s): the default 4 s stopped it at 2e-5 s, out of the comparison
+            // (the peer's sweep runs its 32 elements at 1e-5 s, 20-30 s)
             least_budget: 20.0,
         },
         PeerCase {
