@@ -296,7 +296,7 @@ pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessE
     let base = Scene::load(scene_path)?;
     let first = study_of(&base, opts)?;
     Ok(if opts.recentre {
-        recentre::recentred(&base, opts, first, study_of)
+        recentre::recentred(&base, opts, first)
     } else {
         first
     })

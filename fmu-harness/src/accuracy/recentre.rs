@@ -3,7 +3,7 @@
 //! again with that mesh as the scene's, and the cheaper certified choice is kept.
 
 use super::runner::scene_at;
-use super::{Options, Role, Setting, Study};
+use super::{study_of, Options, Role, Setting, Study};
 use fmu_beam::Scene;
 
 /// The ladders measure the step's error at the scene's mesh and add each mesh's error at one
@@ -14,12 +14,7 @@ use fmu_beam::Scene;
 /// again with that mesh as the scene's, in what is left of the budget, and the cheaper of the
 /// two choices (each certified by its own ladders, finer run and factor) is kept, the other
 /// named in a note.
-pub(super) fn recentred(
-    base: &Scene,
-    opts: &Options,
-    first: Study,
-    study_of: fn(&Scene, &Options) -> Result<Study, crate::HarnessError>,
-) -> Study {
+pub(super) fn recentred(base: &Scene, opts: &Options, mut first: Study) -> Study {
     let Some(c) = first.choice.as_ref() else {
         return first;
     };
@@ -65,7 +60,6 @@ pub(super) fn recentred(
     } else {
         study_of(&moved, &o).map_err(|e| e.to_string())
     };
-    let mut first = first;
     match second {
         Ok(mut second)
             if second
