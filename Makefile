@@ -115,7 +115,8 @@ fmus: release win64
 # glibc 2.28's (`auditwheel show dist/*.whl` says which tag the wheel deserves). The linux64 engine
 # must be linked so too; maturin's cargo build makes it on the way (fmu-beam is a cdylib too), so a
 # first pass builds everything, the engine is copied in, and a second pass (nothing left to
-# compile) packs the wheel. The win64 engine is `make win64`'s.
+# compile) packs the wheel. The win64 engine is `make win64`'s. The wheel is then installed into
+# .venv (its dependencies are requirements.txt's), where the tests of the Python API import it.
 WHEEL_ENGINES := python/fmu_beam/engines
 WHEEL_TARGET  := x86_64-unknown-linux-gnu
 MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" nice $(VENV)/bin/maturin build --release \
@@ -129,6 +130,7 @@ wheel: .venv win64
 	  mkdir -p $(WHEEL_ENGINES)/win64 && cp $(WIN64_ENGINE) $(WHEEL_ENGINES)/win64/; fi
 	$(MATURIN) --out dist
 	rm -rf build/wheel/first
+	$(PY) -m pip install --quiet --no-deps --force-reinstall dist/fmu_beam-*manylinux*.whl
 
 # The win64 wheel (issue 30), not part of `make test` (about 5 more minutes of build): the same
 # package cross-built with the Windows engine's toolchain (Debian's rustc-web, -Zbuild-std,
