@@ -23,6 +23,7 @@ from typing import Any, Dict, List, Optional
 
 from fmu_beam._native import Error, Packaged, Scene, SceneError, SimulationError, Unit, __version__
 from fmu_beam import _native
+from fmu_beam._sweep import sweep
 
 __all__ = [
     "Error",
@@ -36,6 +37,7 @@ __all__ = [
     "main",
     "reference",
     "schema",
+    "sweep",
 ]
 
 
