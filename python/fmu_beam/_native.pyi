@@ -173,23 +173,6 @@ class Unit:
     def units(self, names: Sequence[str]) -> Dict[str, Optional[str]]:
         """The unit of each name (None: dimensionless)."""
 
-def sweep(
-    scene: Union[Scene, StrPath],
-    variants: Any,
-    outputs: Optional[Sequence[str]] = None,
-    reduce: Any = None,
-    client: Any = None,
-    jobs: Optional[int] = None,
-    stop_time: Optional[float] = None,
-    step_size: Optional[float] = None,
-    progress: Optional[bool] = None,
-) -> Any:
-    """(In ``fmu_beam``, from ``fmu_beam._sweep``.) Runs the scene once per variant (a dict of
-    lists: the full factorial; a DataFrame or a list of dicts: one each) of parameter start
-    values or scene edits (dotted paths into the scene's dict), on every local core or on a
-    ``dask.distributed.Client``'s cluster; returns a DataFrame, one row per variant with its
-    reduced outputs and ``error``, or the time series in long form (``reduce=None``)."""
-
 def schema_text() -> str:
     """The JSON Schema of scene files, as text."""
 
