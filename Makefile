@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -300,6 +300,11 @@ example-arm: .venv fmus
 
 example-sweep: .venv fmus
 	$(PY) examples/sweep.py
+
+# The worked study of docs/python.md: the blade's droop over speed and modulus (fmu_beam.sweep on
+# every core; the wheel installed in .venv, as `make wheel` leaves it).
+example-droop: wheel
+	$(PY) examples/blade_droop/droop_sweep.py
 
 clean:
 	rm -rf build dist $(WHEEL_ENGINES) .pytest_cache tests/__pycache__
