@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice example-split example-hinge example-arm example-sweep example-droop clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -274,6 +274,12 @@ bench-choice: release
 	    tail -1 build/accuracy/CHOICE.md; \
 	  done; \
 	done
+
+# What the Python studies cost (issue 44): Scene.simulate against fmpy, a 32-variant sweep on 1
+# and 2 local processes and Dask workers, what a task ships (bench/studies.py, about 8 min);
+# build/bench/STUDIES.md.
+bench-studies: wheel fmus
+	$(PY) bench/studies.py
 
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).
