@@ -1421,3 +1421,54 @@ fn random_call_sequences_never_crash() {
         "a fresh instance after the random calls differs"
     );
 }
+
+/// Issue 45: fmi2SetupExperiment refuses a stop time that is not finite or before the start
+/// time, and a start time at which no step of the solver is representable; fmi2DoStep refuses a
+/// step past the stop time and one that double precision cannot add to the time. Each refusal
+/// is fmi2Error with the reason, and the instance goes on as it was.
+#[test]
+fn times_as_fmi_2_says() {
+    let res = Resources::cantilever();
+    let fmu = Fmu::new(&res);
+    let setup = |start: f64, stop: f64| unsafe {
+        fmi2SetupExperiment(fmu.c, fmi2False, 0.0, start, fmi2True, stop)
+    };
+    for stop in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -1e-3] {
+        assert_eq!(setup(0.0, stop), fmi2Error, "stopTime {stop}");
+    }
+    assert_logged(&fmu.log, "fmi2SetupExperiment", "before startTime = 0 s");
+    assert_eq!(setup(1e15, 1e15 + 1.0), fmi2Error);
+    assert_logged(&fmu.log, "fmi2SetupExperiment", "startTime = 1e15 s");
+    drop(fmu);
+
+    // a stop time equal to the start time: the initial state alone, no step
+    let mut fmu = Fmu::new(&res);
+    assert_eq!(
+        unsafe { fmi2SetupExperiment(fmu.c, fmi2False, 0.0, 0.0, fmi2True, 0.0) },
+        fmi2OK
+    );
+    assert_eq!(unsafe { fmi2EnterInitializationMode(fmu.c) }, fmi2OK);
+    assert_eq!(unsafe { fmi2ExitInitializationMode(fmu.c) }, fmi2OK);
+    assert_eq!(fmu.do_step(H), fmi2Error);
+    assert_logged(&fmu.log, "fmi2DoStep", "past the stopTime 0 s");
+    drop(fmu);
+
+    let mut fmu = Fmu::new(&res);
+    assert_eq!(
+        unsafe { fmi2SetupExperiment(fmu.c, fmi2False, 0.0, 0.0, fmi2True, 10.0 * H) },
+        fmi2OK
+    );
+    assert_eq!(unsafe { fmi2EnterInitializationMode(fmu.c) }, fmi2OK);
+    assert_eq!(unsafe { fmi2ExitInitializationMode(fmu.c) }, fmi2OK);
+    // h = 5e-324 moves a time of 0 by a denormal: below the resolution, refused
+    assert_eq!(fmu.do_step(5e-324), fmi2Error);
+    assert_logged(&fmu.log, "fmi2DoStep", "below the time resolution");
+    assert_eq!(fmu.last_successful_time(), (fmi2OK, 0.0));
+    for _ in 0..10 {
+        assert_eq!(fmu.do_step(H), fmi2OK, "{:?}", fmu.log.all());
+    }
+    assert_eq!(fmu.do_step(H), fmi2Error);
+    assert_logged(&fmu.log, "fmi2DoStep", "past the stopTime");
+    assert_eq!(fmu.last_successful_time().0, fmi2OK);
+    assert!((fmu.last_successful_time().1 - 10.0 * H).abs() < 1e-12);
+}

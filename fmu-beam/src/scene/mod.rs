@@ -13,6 +13,8 @@ mod joint_start;
 mod laws;
 mod limits;
 pub mod matrix_file;
+mod number;
+pub use number::Short;
 mod paths;
 mod placement;
 mod planar;
@@ -33,7 +35,7 @@ pub(crate) use placement::show_length;
 pub use placement::{JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
-pub use validate::SceneError;
+pub use validate::{SceneError, MAX_STEP, MIN_STEP};
 
 /// The default number of space dimensions of a scene.
 fn two() -> u8 {
