@@ -90,15 +90,17 @@ pub enum EngineError {
         tolerance: f64,
     },
     #[error(
-        "doStep: {attempts} internal steps tried between t = {} s and t = {} s without \
-         reaching t = {} s: the work budget of one communication step (documented in \
-         docs/robustness.md) is spent; the last good state is kept (a shorter communication \
-         step, or a scene whose forces and solver settings make sense, goes on)",
+        "doStep: the work budget of one communication step is spent: {work} work units (Newton \
+         iterations times unknowns, factorizations times unknowns squared; solver.step_budget = \
+         {budget}, a few seconds of work, documented in docs/robustness.md) in {attempts} \
+         internal steps between t = {} s and t = {} s, without reaching t = {} s; the last good \
+         state is kept (a shorter communication step, or a scene whose forces and solver \
+         settings make sense, goes on)",
         Short(*.t_start),
         Short(*.t),
         Short(*.t_end)
     )]
-    /// One communication step took more internal steps than the work budget allows.
+    /// One communication step took more work than the work budget allows.
     WorkBudget {
         /// Where the communication step started (s).
         t_start: f64,
@@ -108,6 +110,10 @@ pub enum EngineError {
         t_end: f64,
         /// Internal steps tried (accepted and refused).
         attempts: u64,
+        /// The work done, in `integrator::work_units`.
+        work: u64,
+        /// The budget: `solver.step_budget`.
+        budget: u64,
     },
     #[error(
         "beam '{beam}': deflection {deflection:.3e} m of a floating frame exceeds the frame's \
@@ -343,11 +349,15 @@ impl EngineError {
                 t,
                 t_end,
                 attempts,
+                work,
+                budget,
             } => E::WorkBudget {
                 t_start: origin + t_start,
                 t: origin + t,
                 t_end: origin + t_end,
                 attempts,
+                work,
+                budget,
             },
             E::FeedthroughSingular { t } => E::FeedthroughSingular { t: origin + t },
             E::Diagnosed { cause, diagnosis } => E::Diagnosed {

@@ -535,7 +535,7 @@ pub(crate) const MAX_STEP: Rule = rule(
 pub(crate) const STEP_BUDGET: Rule = rule(
     "step_budget",
     &["solver.step_budget"],
-    "must lie in [1, 2147483647] (internal steps of one communication step, an fmi2Integer)",
+    "must lie in [1, 2147483647] (work units of one communication step, an fmi2Integer)",
     Any,
     Schema::Within(1.0, 2147483647.0),
 );

@@ -473,13 +473,26 @@ impl Stepper {
             }
         };
         let (t_start, mut attempts) = (st.t, 0u64);
+        // the work of this call, counted as it is done ([`super::work_units`])
+        let unknowns = (sys.n() + sys.m()) as u64;
+        let (iterations, factorizations) = (stats.newton_iterations, stats.jacobians);
+        let work = |stats: &Stats| {
+            super::work_units(
+                stats.newton_iterations - iterations,
+                stats.jacobians - factorizations,
+                unknowns,
+            )
+        };
         while !reached(st.t) {
-            if attempts >= set.step_budget {
+            let done = work(stats);
+            if done >= set.step_budget {
                 return Err(EngineError::WorkBudget {
                     t_start,
                     t: st.t,
                     t_end,
                     attempts,
+                    work: done,
+                    budget: set.step_budget,
                 });
             }
             attempts += 1;
