@@ -56,7 +56,7 @@ fn layout(bytes: &[u8]) -> Layout {
     at += 1;
     let time = at;
     at += 8;
-    let mut ga = |at: &mut usize| {
+    let ga = |at: &mut usize| {
         let (t, h) = (*at, *at + 8);
         *at += 24; // t, h, work
         let q = vec(at);

@@ -19,9 +19,12 @@ fn refusal(change: impl FnOnce(&mut Scene)) -> (String, &'static str, String) {
     }
 }
 
+/// A change of a scene.
+type Change = Box<dyn FnOnce(&mut Scene)>;
+
 #[test]
 fn ranges_with_a_physical_reason() {
-    let cases: [(&str, Box<dyn FnOnce(&mut Scene)>, &str); 7] = [
+    let cases: [(&str, Change, &str); 7] = [
         (
             "tolerance_floor",
             Box::new(|s| s.solver.tolerance = 5e-324),

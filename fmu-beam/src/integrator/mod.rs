@@ -12,7 +12,7 @@ pub(crate) mod iteration_matrix;
 pub(crate) mod newton;
 
 pub use generalized_alpha::{iteration_scaling, GaState, Stepper};
-pub(crate) use generalized_alpha::{Controller, MatrixPoint, Memory, SplitReason};
+pub(crate) use generalized_alpha::{within, Controller, MatrixPoint, Memory, SplitReason};
 pub use given_start::{given_start, CoordinateStart};
 pub use initial::{initial_state, initial_state_from};
 pub(crate) use iteration_matrix::Scaling;

@@ -535,9 +535,9 @@ pub(crate) const MAX_STEP: Rule = rule(
 pub(crate) const STEP_BUDGET: Rule = rule(
     "step_budget",
     &["solver.step_budget"],
-    "must lie in [1, 2147483647] (work units of one communication step, an fmi2Integer)",
+    "must lie in [1, 300000000] (work units of one communication step: ten times the default, about a minute of work at most)",
     Any,
-    Schema::Within(1.0, 2147483647.0),
+    Schema::Within(1.0, 300000000.0),
 );
 pub(crate) const RHO_INF: Rule = rule(
     "rho_inf",
@@ -1307,6 +1307,9 @@ mod tests {
         assert!(DENSITY_FLOOR
             .text
             .contains(&format!("at least {MIN_DENSITY} kg/m³")));
+        assert!(STEP_BUDGET
+            .text
+            .contains(&format!("[1, {}]", super::super::validate::MAX_STEP_BUDGET)));
         assert!(LAW.text.ends_with(&LAWS.join(", ")));
         assert!(SHAPE.text.ends_with(&SHAPES.join(", ")));
         assert!(BEAM_OUTPUT

@@ -129,8 +129,10 @@ pub const MIN_STEP: f64 = 1e-9;
 /// pendulum took no step and stayed at rest, at 1e5 s it stopped short, with fmi2OK.)
 pub const MAX_STEP: f64 = 1.0;
 
-/// The largest `solver.step_budget`: the largest fmi2Integer, so that the master can set it.
-pub const MAX_STEP_BUDGET: u64 = i32::MAX as u64;
+/// The largest `solver.step_budget`: ten times the default, so that a doStep a master allowed
+/// the most still ends within about a minute (the largest fmi2Integer, 2147483647 work units,
+/// let a doStep of the pendulum run 151 s: issue 45's fuzz stage found it).
+pub const MAX_STEP_BUDGET: u64 = 10 * super::DEFAULT_STEP_BUDGET;
 
 /// Characters allowed in names that become parts of FMI variable names.
 pub(super) fn is_identifier(s: &str) -> bool {

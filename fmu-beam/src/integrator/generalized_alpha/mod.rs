@@ -26,6 +26,8 @@ mod error_control;
 mod newton_step;
 mod restored;
 
+pub(crate) use restored::within;
+
 pub use error_control::Controller;
 
 /// The integration state at a step boundary.

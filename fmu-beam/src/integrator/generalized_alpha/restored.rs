@@ -26,6 +26,11 @@ const RATE_STEP: f64 = crate::scene::MIN_STEP;
 /// a joint opened by a beam made longer in a closed loop.
 pub const CONSTRAINT_SLACK: f64 = 1e2;
 
+/// Whether |x| ≤ bound (false for NaN).
+pub(crate) fn within(x: f64, bound: f64) -> bool {
+    x.abs() <= bound
+}
+
 impl Stepper {
     /// Why `st` (named `what` in the message) cannot be a state of `sys` stepped by this
     /// stepper, if it cannot: its time not finite or before the start (0), its proposed step
@@ -58,7 +63,7 @@ impl Stepper {
         let beyond = |x: &DVector<f64>, per: f64| {
             x.iter()
                 .zip(scales.iter())
-                .position(|(x, s)| !(x.abs() <= COORDINATE_BOUND * s * per))
+                .position(|(x, s)| !within(*x, COORDINATE_BOUND * s * per))
         };
         let checks = [
             (&st.q, 1.0, "coordinate"),
@@ -91,7 +96,7 @@ impl Stepper {
             let mut g = DVector::zeros(sys.m());
             sys.constraints(&st.q, st.t, &mut g);
             let allowed = CONSTRAINT_SLACK * set.tolerance.max(1e-6) * sys.length_scale().max(1.0);
-            if let Some(k) = g.iter().position(|x| !(x.abs() <= allowed)) {
+            if let Some(k) = g.iter().position(|x| !within(*x, allowed)) {
                 return Some(format!(
                     "{what}: the joints are open: constraint {k} of joint {} is {:e}, beyond \
                      {allowed:e} (the solver's tolerance at the system's length): no state of \

@@ -276,7 +276,7 @@ fn implausible(m: &Model, saved: &ModelState) -> Option<String> {
         ));
     }
     let since = time - m.origin;
-    if !((st.t - since).abs() <= 2.0 * super::times::resolution(time)) {
+    if !crate::integrator::within(st.t - since, 2.0 * super::times::resolution(time)) {
         return Some(format!(
             "its time since the start, {} s, is not its time {} s less its start {} s",
             Short(st.t),
