@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -153,6 +153,15 @@ wheel-win64: wheel
 docs: release
 	$(HARNESS) schema -o scenes/scene.schema.json
 	$(HARNESS) reference -o docs/scene-reference.md
+
+# The fuzz stage (issue 45): seeded and bounded in time, it fails on a crash, a hang or a
+# non-finite output with fmi2OK. Each half is one line: FMI 2.0 call sequences and scene
+# mutations through the engine's exported fmi2* functions (tests/fuzz/fmi_calls.py, about
+# FUZZ_SECONDS plus the packaging of the units). FUZZ_SEED picks the sequences.
+FUZZ_SEED    ?= 45
+FUZZ_SECONDS ?= 120
+fuzz: .venv release
+	nice $(PY) tests/fuzz/fmi_calls.py --engine $(ENGINE) --harness $(HARNESS) --seed $(FUZZ_SEED) --seconds $(FUZZ_SECONDS)
 
 # C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus

@@ -1,7 +1,7 @@
 //! Errors of the engine, carrying the numbers that explain them. The FMI layer maps each to a
 //! status in one place ([`EngineError::is_discard`]).
 
-use crate::scene::SceneError;
+use crate::scene::{SceneError, Short};
 use thiserror::Error;
 
 /// Why the engine refused a call or a step; [`EngineError::is_discard`] tells a step the master
@@ -90,12 +90,17 @@ pub enum EngineError {
         tolerance: f64,
     },
     #[error(
-        "doStep: {attempts} internal steps tried between t = {t_start} s and t = {t} s without \
-         reaching t = {t_end} s: the work budget of one communication step (documented in \
-         docs/robustness.md) is spent; the last good state is kept (a shorter communication \
-         step, or a scene whose forces and solver settings make sense, goes on)"
+        "doStep: the work budget of one communication step is spent: {work} work units (Newton \
+         iterations times unknowns, factorizations times unknowns squared; solver.step_budget = \
+         {budget}, a few seconds of work, documented in docs/robustness.md) in {attempts} \
+         internal steps between t = {} s and t = {} s, without reaching t = {} s; the last good \
+         state is kept (a shorter communication step, or a scene whose forces and solver \
+         settings make sense, goes on)",
+        Short(*.t_start),
+        Short(*.t),
+        Short(*.t_end)
     )]
-    /// One communication step took more internal steps than the work budget allows.
+    /// One communication step took more work than the work budget allows.
     WorkBudget {
         /// Where the communication step started (s).
         t_start: f64,
@@ -105,6 +110,10 @@ pub enum EngineError {
         t_end: f64,
         /// Internal steps tried (accepted and refused).
         attempts: u64,
+        /// The work done, in `integrator::work_units`.
+        work: u64,
+        /// The budget: `solver.step_budget`.
+        budget: u64,
     },
     #[error(
         "beam '{beam}': deflection {deflection:.3e} m of a floating frame exceeds the frame's \
@@ -164,7 +173,7 @@ pub enum EngineError {
         /// Why it cannot be set.
         reason: String,
     },
-    #[error("variable '{name}': value {value} is not a finite number")]
+    #[error("variable '{name}': value {} is not a finite number", Short(*.value))]
     /// A value set was NaN or infinite.
     NonFiniteValue {
         /// The variable's name in the model description.
@@ -172,7 +181,7 @@ pub enum EngineError {
         /// The value refused, in the variable's unit.
         value: f64,
     },
-    #[error("variable '{name}': value {value} is not allowed: {rule}")]
+    #[error("variable '{name}': value {} is not allowed: {rule}", Short(*.value))]
     /// A finite value that the scene's rules refuse (or an input derivative order other
     /// than 1 or 2).
     InvalidValue {
@@ -200,6 +209,13 @@ pub enum EngineError {
     /// A doStep call the instance cannot take: not initialized, a step size not positive and
     /// finite, or a communication point other than the instance's time.
     BadStep {
+        /// Which, with the numbers.
+        message: String,
+    },
+    #[error("fmi2SetupExperiment: {message}")]
+    /// Times fmi2SetupExperiment cannot take: a start time that is not finite or at which the
+    /// solver's steps are below the time resolution, a stop time not finite or before it.
+    Experiment {
         /// Which, with the numbers.
         message: String,
     },
@@ -275,6 +291,79 @@ impl EngineError {
     pub fn cause(&self) -> &EngineError {
         match self {
             EngineError::Diagnosed { cause, .. } => cause,
+            e => e,
+        }
+    }
+}
+
+impl EngineError {
+    /// The same error of the system or the integrator with its times counted from absolute
+    /// time 0 rather than from the run's start `origin` (their time 0,
+    /// `Mechanics::set_time_origin`); the engine's own errors (the validity monitor's) are in
+    /// absolute time already.
+    pub fn at_origin(self, origin: f64) -> EngineError {
+        use EngineError as E;
+        if origin == 0.0 {
+            return self;
+        }
+        match self {
+            E::Assembly {
+                t,
+                residual,
+                joints,
+                tolerance,
+                iterations,
+            } => E::Assembly {
+                t: origin + t,
+                residual,
+                joints,
+                tolerance,
+                iterations,
+            },
+            E::NewtonNotConverged {
+                t,
+                h,
+                iterations,
+                correction,
+            } => E::NewtonNotConverged {
+                t: origin + t,
+                h,
+                iterations,
+                correction,
+            },
+            E::SingularMatrix { t, h } => E::SingularMatrix { t: origin + t, h },
+            E::NonFinite { t } => E::NonFinite { t: origin + t },
+            E::StepTooSmall {
+                t,
+                h,
+                h_min,
+                tolerance,
+            } => E::StepTooSmall {
+                t: origin + t,
+                h,
+                h_min,
+                tolerance,
+            },
+            E::WorkBudget {
+                t_start,
+                t,
+                t_end,
+                attempts,
+                work,
+                budget,
+            } => E::WorkBudget {
+                t_start: origin + t_start,
+                t: origin + t,
+                t_end: origin + t_end,
+                attempts,
+                work,
+                budget,
+            },
+            E::FeedthroughSingular { t } => E::FeedthroughSingular { t: origin + t },
+            E::Diagnosed { cause, diagnosis } => E::Diagnosed {
+                cause: Box::new(cause.at_origin(origin)),
+                diagnosis,
+            },
             e => e,
         }
     }

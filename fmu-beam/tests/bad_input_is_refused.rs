@@ -170,7 +170,7 @@ fn mutated_scenes_are_accepted_or_refused_with_the_field_named() {
                     // a mutant with a tiny max_step ends in the work budget, not minutes later
                     let budget = e.variables().by_name("solver.step_budget").map(|v| v.vr);
                     if let Some(b) = budget {
-                        e.set_integer(b, 20_000).unwrap();
+                        e.set_integer(b, 200_000).unwrap();
                     }
                     // accepted values may still make a model that cannot start or step
                     // (E = 1e300): an error is fine, a panic is not

@@ -14,7 +14,10 @@ pub enum Fill<'a> {
     Xml(&'a str),
 }
 
-/// The template with every placeholder replaced; an unknown or unclosed placeholder is an error.
+/// The template with every placeholder replaced; an unknown or unclosed placeholder is an error,
+/// and so is text that XML 1.0 cannot hold (a control character but tab, line feed and carriage
+/// return, U+FFFE, U+FFFF: the scene's rule `xml_text` refuses them first, this keeps the
+/// packager from writing a document no parser reads, whatever it is given).
 pub fn fill(template: &str, values: &[(&str, Fill)]) -> Result<String, HarnessError> {
     let mut out = String::with_capacity(template.len() * 2);
     let mut rest = template;
@@ -37,7 +40,17 @@ pub fn fill(template: &str, values: &[(&str, Fill)]) -> Result<String, HarnessEr
         out.push_str(&rest[..open]);
         rest = &after[close + 2..];
         match value {
-            Fill::Text(t) => out.push_str(&escape_attribute(t)),
+            Fill::Text(t) => {
+                if let Some(c) = t.chars().find(|&c| !fmu_beam::scene::rules::xml_char(c)) {
+                    return Err(HarnessError::Template {
+                        message: format!(
+                            "{{{{{name}}}}}: the text holds U+{:04X}, which XML 1.0 cannot hold",
+                            c as u32
+                        ),
+                    });
+                }
+                out.push_str(&escape_attribute(t))
+            }
             Fill::Xml(x) => {
                 let line_start = out.rfind('\n').map_or(0, |i| i + 1);
                 let indent = &out[line_start..];
@@ -108,6 +121,27 @@ mod tests {
             out,
             "<a x=\"1 &lt; 2 &amp; &quot;q&quot; \">\n  <b>\n    <c/>\n  </b>\n</a>\n"
         );
+    }
+
+    #[test]
+    fn text_xml_cannot_hold_is_refused_naming_the_placeholder() {
+        for bad in ["a\u{FFFE}b", "\u{FFFF}", "bell\u{7}"] {
+            let e = fill(
+                "<a x=\"{{DESCRIPTION}}\"/>",
+                &[("DESCRIPTION", Fill::Text(bad))],
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(
+                e.contains("{{DESCRIPTION}}") && e.contains("XML 1.0"),
+                "{e}"
+            );
+        }
+        let ok = fill(
+            "<a x=\"{{D}}\"/>",
+            &[("D", Fill::Text("tab\there, é, \u{10FFFF}"))],
+        );
+        assert!(ok.is_ok());
     }
 
     #[test]

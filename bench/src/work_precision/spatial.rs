@@ -393,6 +393,7 @@ fn c5(k: usize, setting: Setting) -> Result<Series, EngineError> {
             law: Some(TimeLaw {
                 law: Law::Table(vec![[0.0, 0.0], [C5_RAMP, 1.0]]),
                 until: None,
+                origin: 0.0,
             }),
         });
         // mid-span: in substructure j at x_local (exact: (0, L/π, 0), the circle's far point)
@@ -462,6 +463,7 @@ fn spin_up(model: Model, setting: Setting) -> Result<Series, EngineError> {
                     ramp: SPIN_RAMP,
                 },
                 until: None,
+                origin: 0.0,
             },
         };
         sys.add_joint("hub", JointKind::Revolute, fw, fa, Some(drive));

@@ -74,13 +74,14 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     toleranceDefined: fmi2Boolean,
     tolerance: fmi2Real,
     startTime: fmi2Real,
-    _stopTimeDefined: fmi2Boolean,
-    _stopTime: fmi2Real,
+    stopTimeDefined: fmi2Boolean,
+    stopTime: fmi2Real,
 ) -> fmi2Status {
     let tolerance = (toleranceDefined != fmi2False).then_some(tolerance);
+    let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
     unsafe {
         guard(c, Call::SetupExperiment, |s| {
-            s.setup_experiment(tolerance, startTime)
+            s.setup_experiment(tolerance, startTime, stop)
         })
     }
 }

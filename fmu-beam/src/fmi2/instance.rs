@@ -100,6 +100,7 @@ impl Instance {
                 | E::InvalidValue { .. }
                 | E::BadStep { .. }
                 | E::BadState { .. }
+                | E::Experiment { .. }
                 | E::DirectionalDerivative { .. }
                 | E::FeedthroughSingular { .. }
         );
@@ -144,12 +145,18 @@ impl Instance {
 
     /// fmi2SetupExperiment: a defined tolerance goes to `solver.tolerance`, as the standard asks
     /// (the master's tolerance is the one to use), with a warning when it is looser than the
-    /// scene's; the log says which tolerance the unit runs at and where it came from.
+    /// scene's; the log says which tolerance the unit runs at and where it came from. The start
+    /// and a defined stop time are checked first (`Engine::check_experiment`), so that a refusal
+    /// changes nothing.
     pub fn setup_experiment(
         &mut self,
         tolerance: Option<f64>,
         start_time: f64,
+        stop_time: Option<f64>,
     ) -> Result<(), Fault> {
+        self.engine
+            .check_experiment(start_time, stop_time)
+            .map_err(|e| self.fail(e))?;
         let scene = self.scene_tolerance();
         if let (Some(tolerance), Some((vr, _))) = (tolerance, scene) {
             self.engine
@@ -157,7 +164,7 @@ impl Instance {
                 .map_err(|e| self.fail(e))?;
         }
         self.engine
-            .set_start_time(start_time)
+            .set_experiment(start_time, stop_time)
             .map_err(|e| self.fail(e))?;
         self.master_tolerance = tolerance;
         if let Some((_, scene)) = scene {

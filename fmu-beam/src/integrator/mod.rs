@@ -12,7 +12,7 @@ pub(crate) mod iteration_matrix;
 pub(crate) mod newton;
 
 pub use generalized_alpha::{iteration_scaling, GaState, Stepper};
-pub(crate) use generalized_alpha::{Controller, MatrixPoint, Memory, SplitReason};
+pub(crate) use generalized_alpha::{within, Controller, MatrixPoint, Memory, SplitReason};
 pub use given_start::{given_start, CoordinateStart};
 pub use initial::{initial_state, initial_state_from};
 pub(crate) use iteration_matrix::Scaling;
@@ -35,16 +35,37 @@ pub struct Settings {
     pub max_step: f64,
     /// Spectral radius at infinity ρ∞ of generalized-α (1): 1 = no numerical damping.
     pub rho_inf: f64,
-    /// The work budget of one communication step ([`Stepper::advance`]): internal steps tried,
-    /// accepted or refused; past it the step ends in [`EngineError::WorkBudget`] (a Discard).
+    /// The work budget of one communication step ([`Stepper::advance`]), in work units
+    /// ([`work_units`]); past it the step ends in [`EngineError::WorkBudget`] (a Discard).
     pub step_budget: u64,
 }
 
-/// The default work budget of a communication step: at about 15 µs a step of a small scene
-/// (the pendulum), 15 s of work. A communication step that needs more (a doStep of 1e6 s; a
-/// force of 1e18 N or gravity of 1e9 m/s² did, which the scene's ranges now refuse) ends in a
-/// Discard instead of running for hours; `solver.step_budget` sets it.
-pub const DEFAULT_STEP_BUDGET: u64 = 1_000_000;
+/// The default work budget of a communication step, in [`work_units`]: 3e7 units are 2–4 s on
+/// the shipped scenes (60–200 ns a unit, measured over their default experiments on one core
+/// of the development machine: `fmu-beam/tests/issue_45_work_budget.rs`). A communication step
+/// that needs more (a doStep of 1e6 s took 287 s on rollup_3d and 66 s on spin_up_omega10
+/// when the budget counted 1e6 internal steps, whatever each cost) ends in a Discard within
+/// seconds instead; `solver.step_budget` sets it. No doStep of a shipped scene's
+/// DefaultExperiment comes near it (the largest takes 6e4 units).
+pub const DEFAULT_STEP_BUDGET: u64 = crate::scene::DEFAULT_STEP_BUDGET;
+
+/// Work units per Newton iteration beyond one per unknown: the iteration's fixed cost (the
+/// step's bookkeeping, the error estimate), about 30 unknowns' worth on the shipped scenes
+/// (a scene of 5 unknowns spends 5.8 µs an iteration, one of 35 spends 9 µs).
+const ITERATION_OVERHEAD: u64 = 32;
+
+/// The work of `iterations` Newton iterations and `factorizations` iteration matrices (each
+/// evaluated and factorized) for a system of `unknowns` (n + m): iterations × (unknowns +
+/// [`ITERATION_OVERHEAD`]) + factorizations × unknowns² / 4. The time of a run follows it to a
+/// factor of 2 over every shipped scene (a residual and a solve cost about one unit per
+/// unknown; evaluating the tangents and factorizing, dense below 60 unknowns and sparse above,
+/// a quarter unit per unknown squared: 30–55 ns per unknown² measured, the roll-up's 3D
+/// tangents by central differences included).
+pub fn work_units(iterations: u64, factorizations: u64, unknowns: u64) -> u64 {
+    iterations
+        .saturating_mul(unknowns + ITERATION_OVERHEAD)
+        .saturating_add(factorizations.saturating_mul(unknowns * unknowns / 4))
+}
 
 impl Settings {
     /// The settings of the scene's `solver` entry.

@@ -32,6 +32,29 @@ macro_rules! each {
 }
 
 impl Mechanics {
+    /// Makes absolute time `origin` the system's time 0: every drive and load law is evaluated
+    /// at `origin` + the system's time. The integrator then steps in the system's time, which
+    /// double precision resolves at any start time as finely as at 0: a run started at `origin`
+    /// takes the steps of one started at 0 (issue 45).
+    pub fn set_time_origin(&mut self, origin: f64) {
+        match self {
+            Mechanics::Planar(s) => {
+                let drives = s.joints.iter_mut().filter_map(|j| j.drive.as_mut());
+                let loads = s.loads.iter_mut().filter_map(|l| l.scale.as_mut());
+                for law in drives.map(|d| &mut d.law).chain(loads) {
+                    law.origin = origin;
+                }
+            }
+            Mechanics::Spatial(s, _) => {
+                let drives = s.joints.iter_mut().filter_map(|j| j.drive.as_mut());
+                let loads = s.loads.iter_mut().filter_map(|l| l.law.as_mut());
+                for law in drives.map(|d| &mut d.law).chain(loads) {
+                    law.origin = origin;
+                }
+            }
+        }
+    }
+
     /// The FMU inputs as the system holds them, by input slot.
     pub fn inputs(&self) -> &[InputValue] {
         each!(self, s => &s.inputs)

@@ -27,7 +27,8 @@ pub(super) fn parts(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// A `description` of at most [`r::MAX_DESCRIPTION_LENGTH`] characters.
+/// A `description` of at most [`r::MAX_DESCRIPTION_LENGTH`] characters, each one XML 1.0 holds
+/// ([`r::xml_char`]: it goes into modelDescription.xml).
 pub(super) fn description(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
     let chars = s.description.chars().count();
     if chars > r::MAX_DESCRIPTION_LENGTH {
@@ -35,6 +36,18 @@ pub(super) fn description(ck: &Checker, s: &Scene) -> Result<(), SceneError> {
             &r::DESCRIPTION_LENGTH,
             "description",
             format!("a text of {chars} characters"),
+        ));
+    }
+    if let Some((k, c)) = s
+        .description
+        .chars()
+        .enumerate()
+        .find(|(_, c)| !r::xml_char(*c))
+    {
+        return Err(ck.fail(
+            &r::XML_TEXT,
+            "description",
+            format!("a text with U+{:04X} at character {}", c as u32, k + 1),
         ));
     }
     Ok(())

@@ -13,6 +13,8 @@ mod joint_start;
 mod laws;
 mod limits;
 pub mod matrix_file;
+mod number;
+pub use number::Short;
 mod paths;
 mod placement;
 mod planar;
@@ -33,7 +35,7 @@ pub(crate) use placement::show_length;
 pub use placement::{JointGap, GAP_TOLERANCE};
 pub use size::Size;
 pub use space::SPATIAL_EFFECTS;
-pub use validate::SceneError;
+pub use validate::{SceneError, MAX_STEP, MIN_STEP};
 
 /// The default number of space dimensions of a scene.
 fn two() -> u8 {
@@ -168,10 +170,11 @@ pub struct SolverSpec {
     #[cfg_attr(feature = "schema", schemars(extend("x-unit" = "1")))]
     #[serde(default = "default_rho_inf")]
     pub rho_inf: f64,
-    /// The work budget of one communication step: internal steps tried (accepted or refused)
-    /// before the step ends in fmi2Discard with the reason, the last good state kept. The
-    /// default, 1 000 000, is about 15 s of work on the C2 pendulum; a master that takes long
-    /// communication steps of a fine fixed step raises it.
+    /// The work budget of one communication step, in work units (Newton iterations times
+    /// unknowns plus 32, plus iteration matrices times unknowns² / 4) before the step ends in
+    /// fmi2Discard with the reason, the last good state kept. The default, 30 000 000, is 2–4 s of work on any
+    /// shipped scene; a master that takes long communication steps of a fine fixed step
+    /// raises it.
     #[serde(default = "default_step_budget")]
     pub step_budget: u64,
 }
@@ -189,8 +192,12 @@ fn default_rho_inf() -> f64 {
     0.9
 }
 fn default_step_budget() -> u64 {
-    1_000_000
+    DEFAULT_STEP_BUDGET
 }
+
+/// The default `solver.step_budget`, in work units: 2–4 s of work on any shipped scene
+/// (`integrator::work_units` says what a unit is and what it was measured to cost).
+pub const DEFAULT_STEP_BUDGET: u64 = 30_000_000;
 
 impl Default for SolverSpec {
     fn default() -> Self {

@@ -217,6 +217,43 @@ pub(crate) const DENSITY_RANGE: Rule = rule(
     Schema::Within(-1e7, 1e7),
 );
 /// A [`RANGES`] rule.
+pub(crate) const AREA_RANGE: Rule = rule(
+    "area_range",
+    &["beam[].section.A"],
+    "must be at most 1e8 m² in magnitude (a section within a square whose side is the largest length, 1e4 m)",
+    Any,
+    Schema::Within(-1e8, 1e8),
+);
+/// A [`RANGES`] rule.
+pub(crate) const SECOND_MOMENT_RANGE: Rule = rule(
+    "second_moment_range",
+    &[
+        "beam[].section.J",
+        "beam[].section.Iy",
+        "beam[].section.Iz",
+        "beam[].section.It",
+    ],
+    "must be at most 1e16 m⁴ in magnitude (above a section within a square whose side is the largest length, 1e4 m: its polar moment is 1.7e15 m⁴)",
+    Any,
+    Schema::Within(-1e16, 1e16),
+);
+/// A [`RANGES`] rule.
+pub(crate) const RAYLEIGH_ALPHA_RANGE: Rule = rule(
+    "rayleigh_alpha_range",
+    &["beam[].rayleigh.alpha"],
+    "must be at most 1e9 1/s in magnitude (the deformation's velocity decays at the rate alpha: a decay faster than the smallest internal step, 1e-9 s, is one no step resolves)",
+    Any,
+    Schema::Within(-1e9, 1e9),
+);
+/// A [`RANGES`] rule.
+pub(crate) const RAYLEIGH_BETA_RANGE: Rule = rule(
+    "rayleigh_beta_range",
+    &["beam[].rayleigh.beta"],
+    "must be at most 1e9 s in magnitude (beta = viscosity / modulus is the retardation time of a Kelvin-Voigt solid: a deformation that relaxes only after the longest run a scene may ask for, 1e9 s, describes no beam)",
+    Any,
+    Schema::Within(-1e9, 1e9),
+);
+/// A [`RANGES`] rule.
 pub(crate) const MASS_RANGE: Rule = rule(
     "mass_range",
     &["body[].mass"],
@@ -283,6 +320,10 @@ pub const RANGES: &[(Rule, f64)] = &[
     (LENGTH_RANGE, 1e4),
     (MODULUS_RANGE, 1e16),
     (DENSITY_RANGE, 1e7),
+    (AREA_RANGE, 1e8),
+    (SECOND_MOMENT_RANGE, 1e16),
+    (RAYLEIGH_ALPHA_RANGE, 1e9),
+    (RAYLEIGH_BETA_RANGE, 1e9),
     (MASS_RANGE, 1e9),
     (INERTIA_RANGE, 1e12),
     (LOAD_RANGE, 1e12),
@@ -411,6 +452,41 @@ pub(crate) const DIMENSIONS: Rule = rule(
     Any,
     Schema::OneOfIntegers(&[2, 3]),
 );
+/// The smallest `solver.tolerance`: about 450 machine epsilons. The error estimate is a third
+/// divided difference of four positions, each known to a machine epsilon of its size: about 8 ε
+/// of rounding. Below this the estimate is that rounding, and 5e-324 had every step Discarded
+/// ("last correction inf").
+pub const MIN_TOLERANCE: f64 = 1e-13;
+/// Its text quotes [`MIN_TOLERANCE`] (a test checks it).
+pub(crate) const TOLERANCE_FLOOR: Rule = rule(
+    "tolerance_floor",
+    &["solver.tolerance"],
+    "must be at least 1e-13 (450 machine epsilons: below it the error estimate, a third difference of positions known to a machine epsilon, is rounding)",
+    Any,
+    Schema::AtLeast(MIN_TOLERANCE),
+);
+/// The smallest `beam[].material.rho` (kg/m³).
+pub const MIN_DENSITY: f64 = 0.1;
+/// Its text quotes [`MIN_DENSITY`] (a test checks it).
+pub(crate) const DENSITY_FLOOR: Rule = rule(
+    "density_floor",
+    &["beam[].material.rho"],
+    "must be at least 0.1 kg/m³ (no solid is lighter: graphene aerogel is 0.16 kg/m³; rho = 1e-300 left the beam a mass matrix of denormals)",
+    Any,
+    Schema::AtLeast(MIN_DENSITY),
+);
+/// XML 1.0 (§2.2, `Char`) holds tab, line feed, carriage return and the characters from U+0020
+/// on, but not U+FFFE and U+FFFF (surrogates cannot occur in Rust text).
+pub fn xml_char(c: char) -> bool {
+    matches!(c, '\t' | '\n' | '\r') || (c >= ' ' && c != '\u{FFFE}' && c != '\u{FFFF}')
+}
+pub(crate) const XML_TEXT: Rule = rule(
+    "xml_text",
+    &["description"],
+    "must hold only characters XML 1.0 allows: no control characters but tab, line feed and carriage return, no U+FFFE or U+FFFF (the text goes into modelDescription.xml)",
+    Any,
+    Schema::None,
+);
 pub(crate) const TOLERANCE_BELOW_ONE: Rule = rule(
     "tolerance_below_one",
     &["solver.tolerance"],
@@ -459,9 +535,9 @@ pub(crate) const MAX_STEP: Rule = rule(
 pub(crate) const STEP_BUDGET: Rule = rule(
     "step_budget",
     &["solver.step_budget"],
-    "must lie in [1, 2147483647] (internal steps of one communication step, an fmi2Integer)",
+    "must lie in [1, 300000000] (work units of one communication step: ten times the default, about a minute of work at most)",
     Any,
-    Schema::Within(1.0, 2147483647.0),
+    Schema::Within(1.0, 300000000.0),
 );
 pub(crate) const RHO_INF: Rule = rule(
     "rho_inf",
@@ -1038,6 +1114,10 @@ pub const RULES: &[Rule] = &[
     LENGTH_RANGE,
     MODULUS_RANGE,
     DENSITY_RANGE,
+    AREA_RANGE,
+    SECOND_MOMENT_RANGE,
+    RAYLEIGH_ALPHA_RANGE,
+    RAYLEIGH_BETA_RANGE,
     MASS_RANGE,
     INERTIA_RANGE,
     LOAD_RANGE,
@@ -1048,6 +1128,7 @@ pub const RULES: &[Rule] = &[
     SCENE_NAME,
     NAME_LENGTH,
     DESCRIPTION_LENGTH,
+    XML_TEXT,
     PARTS_MAX,
     DIMENSIONS,
     SPATIAL_FORMULATION,
@@ -1059,6 +1140,8 @@ pub const RULES: &[Rule] = &[
     IN_PLANE,
     SPATIAL_VECTOR,
     TOLERANCE_BELOW_ONE,
+    TOLERANCE_FLOOR,
+    DENSITY_FLOOR,
     ACCURACY_TARGET,
     ACCURACY_ESTIMATE,
     ACCURACY_OUTPUT,
@@ -1218,6 +1301,15 @@ mod tests {
         assert!(MIN_STEP
             .text
             .contains(&format!("{:e} s", super::super::validate::MIN_STEP)));
+        assert!(TOLERANCE_FLOOR
+            .text
+            .contains(&format!("at least {MIN_TOLERANCE:e} (")));
+        assert!(DENSITY_FLOOR
+            .text
+            .contains(&format!("at least {MIN_DENSITY} kg/m³")));
+        assert!(STEP_BUDGET
+            .text
+            .contains(&format!("[1, {}]", super::super::validate::MAX_STEP_BUDGET)));
         assert!(LAW.text.ends_with(&LAWS.join(", ")));
         assert!(SHAPE.text.ends_with(&SHAPES.join(", ")));
         assert!(BEAM_OUTPUT

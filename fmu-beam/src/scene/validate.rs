@@ -4,6 +4,7 @@ use super::paths::Part;
 use super::rules::{self as r, Rule};
 use super::{
     BeamSpec, DriveKind, EffectsSpec, FrameKind, JointKind, RigidBodySpec, Scene, SectionSpec,
+    Short,
 };
 use thiserror::Error;
 
@@ -91,10 +92,10 @@ impl Checker<'_> {
     /// A finite number, within its quantity's range where it has one ([`r::RANGES`]).
     pub(super) fn finite(&self, field: &str, v: f64) -> Result<(), SceneError> {
         if !v.is_finite() {
-            return Err(self.fail(&r::FINITE, field, v));
+            return Err(self.fail(&r::FINITE, field, Short(v)));
         }
         match r::range_of(field) {
-            Some((rule, bound)) if v.abs() > *bound => Err(self.fail(rule, field, v)),
+            Some((rule, bound)) if v.abs() > *bound => Err(self.fail(rule, field, Short(v))),
             _ => Ok(()),
         }
     }
@@ -104,7 +105,7 @@ impl Checker<'_> {
         if v > 0.0 {
             Ok(())
         } else {
-            Err(self.fail(&r::POSITIVE, field, v))
+            Err(self.fail(&r::POSITIVE, field, Short(v)))
         }
     }
 
@@ -113,7 +114,7 @@ impl Checker<'_> {
         if v >= 0.0 {
             Ok(())
         } else {
-            Err(self.fail(&r::NON_NEGATIVE, field, v))
+            Err(self.fail(&r::NON_NEGATIVE, field, Short(v)))
         }
     }
 }
@@ -128,8 +129,10 @@ pub const MIN_STEP: f64 = 1e-9;
 /// pendulum took no step and stayed at rest, at 1e5 s it stopped short, with fmi2OK.)
 pub const MAX_STEP: f64 = 1.0;
 
-/// The largest `solver.step_budget`: the largest fmi2Integer, so that the master can set it.
-pub const MAX_STEP_BUDGET: u64 = i32::MAX as u64;
+/// The largest `solver.step_budget`: ten times the default, so that a doStep a master allowed
+/// the most still ends within about a minute (the largest fmi2Integer, 2147483647 work units,
+/// let a doStep of the pendulum run 151 s: issue 45's fuzz stage found it).
+pub const MAX_STEP_BUDGET: u64 = 10 * super::DEFAULT_STEP_BUDGET;
 
 /// Characters allowed in names that become parts of FMI variable names.
 pub(super) fn is_identifier(s: &str) -> bool {
@@ -156,7 +159,14 @@ impl Scene {
         let s = &self.solver;
         ck.positive("solver.tolerance", s.tolerance)?;
         if s.tolerance >= 1.0 {
-            return Err(ck.fail(&r::TOLERANCE_BELOW_ONE, "solver.tolerance", s.tolerance));
+            return Err(ck.fail(
+                &r::TOLERANCE_BELOW_ONE,
+                "solver.tolerance",
+                Short(s.tolerance),
+            ));
+        }
+        if s.tolerance < r::MIN_TOLERANCE {
+            return Err(ck.fail(&r::TOLERANCE_FLOOR, "solver.tolerance", Short(s.tolerance)));
         }
         ck.positive("solver.max_step", s.max_step)?;
         if s.max_step < MIN_STEP {
@@ -420,6 +430,9 @@ fn validate_beam(ck: &Checker, b: &BeamSpec, path: &str, three: bool) -> Result<
         }
     }
     ck.positive(&f("material.rho"), b.material.rho)?;
+    if b.material.rho < r::MIN_DENSITY {
+        return Err(ck.fail(&r::DENSITY_FLOOR, &f("material.rho"), Short(b.material.rho)));
+    }
     ck.positive(&f("material.E"), b.material.e)?;
     if let Some(g) = b.material.g {
         ck.positive(&f("material.G"), g)?;

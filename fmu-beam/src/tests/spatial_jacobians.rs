@@ -38,6 +38,7 @@ fn drive(kind: DriveKind) -> Option<Drive> {
         law: TimeLaw {
             law: Law::Constant(0.3),
             until: None,
+            origin: 0.0,
         },
     })
 }

@@ -400,6 +400,7 @@ fn c5(k: usize, axis: usize) -> (f64, f64) {
         law: Some(crate::mechanics::multibody::law::TimeLaw {
             law: crate::mechanics::multibody::law::Law::Table(vec![[0.0, 0.0], [2.0, 1.0]]),
             until: None,
+            origin: 0.0,
         }),
     });
     let settings = Settings {

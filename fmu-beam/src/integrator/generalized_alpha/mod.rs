@@ -24,6 +24,9 @@ use nalgebra::DVector;
 
 mod error_control;
 mod newton_step;
+mod restored;
+
+pub(crate) use restored::within;
 
 pub use error_control::Controller;
 
@@ -472,13 +475,26 @@ impl Stepper {
             }
         };
         let (t_start, mut attempts) = (st.t, 0u64);
+        // the work of this call, counted as it is done ([`super::work_units`])
+        let unknowns = (sys.n() + sys.m()) as u64;
+        let (iterations, factorizations) = (stats.newton_iterations, stats.jacobians);
+        let work = |stats: &Stats| {
+            super::work_units(
+                stats.newton_iterations - iterations,
+                stats.jacobians - factorizations,
+                unknowns,
+            )
+        };
         while !reached(st.t) {
-            if attempts >= set.step_budget {
+            let done = work(stats);
+            if done >= set.step_budget {
                 return Err(EngineError::WorkBudget {
                     t_start,
                     t: st.t,
                     t_end,
                     attempts,
+                    work: done,
+                    budget: set.step_budget,
                 });
             }
             attempts += 1;
@@ -496,6 +512,8 @@ impl Stepper {
                 .find(|&b| b > st.t)
                 .unwrap_or(f64::INFINITY);
             let mut target = bp;
+            // no jump ahead (bp infinite) is never one to land on
+            let at_jump = |target: f64| bp.is_finite() && target == bp;
             if land {
                 target = target.min(t_end);
             }
@@ -516,7 +534,7 @@ impl Stepper {
             // step: an explicit Taylor step of that length is exact to its order
             if remaining <= TINY * nominal {
                 self.slide(st, target);
-                if target == bp {
+                if at_jump(target) {
                     self.meet_jump(sys, st, nominal)?;
                 }
                 if divided_until.is_some_and(|d| d <= st.t) {
@@ -564,11 +582,14 @@ impl Stepper {
                         stats.steps += 1;
                         self.memory.noise *= NOISE_DECAY;
                         if !set.adaptive {
-                            if h < set.max_step * (1.0 - SPLIT) {
+                            // cut short, not a grid step that rounding made shorter (far from
+                            // t = 0 the grid's steps differ from max_step by its rounding)
+                            let cut = h < nominal || divided_until.is_some();
+                            if cut && h < set.max_step * (1.0 - SPLIT) {
                                 stats.split += 1;
                                 let why = if divided_until.is_some() {
                                     SplitReason::Newton
-                                } else if target == bp {
+                                } else if at_jump(target) {
                                     SplitReason::Breakpoint
                                 } else {
                                     SplitReason::Landing
@@ -582,7 +603,7 @@ impl Stepper {
                                 _ => self.landed(t_new),
                             }
                         }
-                        if last && target == bp {
+                        if last && at_jump(target) {
                             self.meet_jump(sys, st, h)?;
                         }
                         if last && divided_until == Some(target) {

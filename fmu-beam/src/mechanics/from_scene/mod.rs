@@ -71,10 +71,7 @@ impl TimeLaw {
             "input" => Law::Input(slot.unwrap_or(0)),
             _ => Law::Constant(v),
         };
-        TimeLaw {
-            law,
-            until: spec.until,
-        }
+        TimeLaw::new(law, spec.until)
     }
 }
 

@@ -65,11 +65,35 @@ pub struct TimeLaw {
     pub law: Law,
     /// The law is zero from this time on.
     pub until: Option<f64>,
+    /// The absolute time of the system's time 0 (the run's start time): the law is a function
+    /// of absolute time, evaluated at `origin + t` for the system's time t, while an input's
+    /// extrapolation and the integrator work in the system's time, which double precision
+    /// resolves as finely at any start time ([`TimeLaw::shifted`]).
+    pub origin: f64,
 }
 
 impl TimeLaw {
-    /// (f(t), f'(t), f''(t)).
+    /// A law of absolute time `law` (zero from `until` on), in a system whose time 0 is
+    /// absolute time 0.
+    pub fn new(law: Law, until: Option<f64>) -> TimeLaw {
+        TimeLaw {
+            law,
+            until,
+            origin: 0.0,
+        }
+    }
+
+    /// The same law in a system whose time 0 is absolute time `origin`.
+    pub fn shifted(mut self, origin: f64) -> TimeLaw {
+        self.origin = origin;
+        self
+    }
+
+    /// (f(t), f'(t), f''(t)) at the system's time t (absolute time `origin + t`; an input's
+    /// extrapolation in the system's time, as its `t0` is).
     pub fn eval(&self, t: f64, inputs: &[InputValue]) -> (f64, f64, f64) {
+        let tau = t;
+        let t = self.origin + tau;
         if self.until.is_some_and(|u| t > u) {
             return (0.0, 0.0, 0.0);
         }
@@ -107,7 +131,7 @@ impl TimeLaw {
             }
             Law::Input(slot) => {
                 let u = inputs.get(*slot).copied().unwrap_or_default();
-                let dt = t - u.t0;
+                let dt = tau - u.t0;
                 (
                     u.value + u.der1 * dt + 0.5 * u.der2 * dt * dt,
                     u.der1 + u.der2 * dt,
@@ -117,13 +141,17 @@ impl TimeLaw {
         }
     }
 
-    /// Times where the law or its derivatives jump: the integrator lands on them.
+    /// Times where the law or its derivatives jump, in the system's time: the integrator lands
+    /// on them.
     pub fn breakpoints(&self) -> Vec<f64> {
         let mut b: Vec<f64> = self.until.into_iter().collect();
         match &self.law {
             Law::SpinUp { ramp, .. } => b.push(*ramp),
             Law::Table(rows) => b.extend(rows.iter().map(|r| r[0])),
             _ => {}
+        }
+        for t in &mut b {
+            *t -= self.origin;
         }
         b
     }
@@ -160,13 +188,13 @@ mod tests {
 
     #[test]
     fn spin_up_is_smooth_and_reaches_omega() {
-        let law = TimeLaw {
-            law: Law::SpinUp {
+        let law = TimeLaw::new(
+            Law::SpinUp {
                 omega: 4.0,
                 ramp: 15.0,
             },
-            until: None,
-        };
+            None,
+        );
         check_derivatives(&law, &[0.3, 7.0, 14.0, 16.0]);
         let (th, w, a) = law.eval(15.0, &[]);
         assert!((th - 4.0 * 7.5).abs() < 1e-12 && (w - 4.0).abs() < 1e-12 && a.abs() < 1e-12);
@@ -175,13 +203,13 @@ mod tests {
 
     #[test]
     fn exponential_torque_cuts_off() {
-        let law = TimeLaw {
-            law: Law::Exponential {
+        let law = TimeLaw::new(
+            Law::Exponential {
                 value: 0.01,
                 tau: 0.167,
             },
-            until: Some(0.7),
-        };
+            Some(0.7),
+        );
         check_derivatives(&law, &[0.1, 0.5]);
         assert!((law.eval(0.7, &[]).0 - 0.01 * (1.0 - (-0.7f64 / 0.167).exp())).abs() < 1e-15);
         assert_eq!(law.eval(0.70001, &[]).0, 0.0);
@@ -190,10 +218,7 @@ mod tests {
 
     #[test]
     fn table_interpolates() {
-        let law = TimeLaw {
-            law: Law::Table(vec![[0.0, 0.0], [1.0, 2.0], [3.0, 0.0]]),
-            until: None,
-        };
+        let law = TimeLaw::new(Law::Table(vec![[0.0, 0.0], [1.0, 2.0], [3.0, 0.0]]), None);
         assert_eq!(law.eval(0.5, &[]), (1.0, 2.0, 0.0));
         assert_eq!(law.eval(2.0, &[]), (1.0, -1.0, 0.0));
         assert_eq!(law.eval(5.0, &[]).0, 0.0);

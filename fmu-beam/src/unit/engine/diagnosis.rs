@@ -49,10 +49,7 @@ impl Engine {
             .flatten()
             .map(|i| (self.values[self.input_var(i.slot)], i.speed(&m.state.v)))
             .collect();
-        let probe = InputProbe {
-            t: m.state.t,
-            values,
-        };
+        let probe = InputProbe { t: m.time, values };
         match &self.probes[1] {
             Some(last) if last.t == probe.t => {}
             _ => self.probes[0] = self.probes[1].take(),

@@ -15,6 +15,7 @@ mod parameters;
 mod setting;
 mod start;
 mod state;
+mod times;
 mod tunable_loads;
 mod validity;
 
@@ -33,6 +34,13 @@ use crate::unit::variables::{Binding, Causality, OutputKind, VarType, Variabilit
 #[derive(Debug, Clone)]
 struct Model {
     system: Mechanics,
+    /// The absolute time of the system's time 0: the run's start time. The system, the
+    /// integrator and every `GaState` count time from it (`Mechanics::set_time_origin`), so
+    /// that a run started at 1e11 s takes the steps of one started at 0.
+    origin: f64,
+    /// The absolute time of the current communication point, as the master counts it (the
+    /// sum of its steps): `state.t` is this less `origin`.
+    time: f64,
     /// The state at the current communication point.
     state: GaState,
     /// The integrator's own state, at the end of its last step; a unit steps across
@@ -63,6 +71,7 @@ struct Model {
 /// The integration state of a built model, as get/set FMU state copy it.
 #[derive(Debug, Clone, PartialEq)]
 struct ModelState {
+    time: f64,
     state: GaState,
     front: GaState,
     back: Option<GaState>,
@@ -114,6 +123,8 @@ pub struct Engine {
     chords: std::collections::VecDeque<(f64, Vec<nalgebra::Vector3<f64>>)>,
     initialized: bool,
     start_time: f64,
+    /// fmi2SetupExperiment's stopTime when stopTimeDefined: no step may end past it.
+    stop_time: Option<f64>,
     model: Option<Model>,
     /// Accelerations consistent with the inputs set now, and their derivatives.
     feedthrough: crate::unit::interface::Feedthrough,
@@ -152,6 +163,7 @@ impl Engine {
             values,
             initialized: false,
             start_time: 0.0,
+            stop_time: None,
             model: None,
             feedthrough: Default::default(),
             identity,
@@ -170,7 +182,7 @@ impl Engine {
 
     /// Simulated time of the last accepted communication point.
     pub fn time(&self) -> f64 {
-        self.model.as_ref().map_or(self.start_time, |m| m.state.t)
+        self.model.as_ref().map_or(self.start_time, |m| m.time)
     }
 
     /// Back to the state right after instantiation: parameters at their start values.
@@ -314,13 +326,17 @@ impl Engine {
                 self.built()?;
                 let m = self.model.as_mut().expect("built above");
                 let (sys, st) = (&mut m.system, &m.state);
-                (self.feedthrough).drive_reaction(sys, st, m.joint_index[j])
+                (self.feedthrough)
+                    .drive_reaction(sys, st, m.joint_index[j])
+                    .map_err(|e| e.at_origin(m.origin))
             }
             Binding::Output(OutputKind::LoadFrame(load, what)) => {
                 self.built()?;
                 let m = self.model.as_mut().expect("built above");
                 let (sys, st) = (&mut m.system, &m.state);
-                (self.feedthrough).frame_output(sys, st, &self.scene, load, what)
+                (self.feedthrough)
+                    .frame_output(sys, st, &self.scene, load, what)
+                    .map_err(|e| e.at_origin(m.origin))
             }
             Binding::Output(kind) => {
                 let m = self.built()?;
@@ -341,16 +357,18 @@ impl Engine {
         self.built()?;
         let m = self.model.as_mut().expect("built above");
         let (sys, st) = (&mut m.system, &m.state);
-        self.feedthrough.directional_derivative(
-            sys,
-            st,
-            &self.scene,
-            &self.table,
-            &m.joint_index,
-            unknowns,
-            knowns,
-            dv,
-        )
+        self.feedthrough
+            .directional_derivative(
+                sys,
+                st,
+                &self.scene,
+                &self.table,
+                &m.joint_index,
+                unknowns,
+                knowns,
+                dv,
+            )
+            .map_err(|e| e.at_origin(m.origin))
     }
 
     /// The scene with the given parameter values applied.
@@ -406,7 +424,9 @@ impl Engine {
             scene.validate("parameters")?;
             self.warn_if_auto_would_differ(&scene);
             crate::unit::memory::ensure_available(&scene, "initialization")?;
+            let origin = self.start_time;
             let mut system = Mechanics::build(&scene, &self.effects);
+            system.set_time_origin(origin);
             let settings = Settings::from_scene(&scene);
             for (i, var) in self.table.variables.iter().enumerate() {
                 if let Binding::Input(slot) = var.binding {
@@ -415,15 +435,17 @@ impl Engine {
                         value: self.values[i],
                         der1,
                         der2,
-                        t0: self.start_time,
+                        t0: 0.0,
                     };
                 }
             }
-            let t0 = self.start_time;
-            let state = match start::given(&scene, &self.effects, &system, t0)? {
-                Some((q, v)) => integrator::initial_state_from(&system, t0, &settings, q, v)?,
-                None => integrator::initial_state(&system, t0, &settings)?,
-            };
+            // the system's time 0 is the start time
+            let state = match start::given(&scene, &self.effects, &system, origin) {
+                Ok(Some((q, v))) => integrator::initial_state_from(&system, 0.0, &settings, q, v),
+                Ok(None) => integrator::initial_state(&system, 0.0, &settings),
+                Err(e) => Err(e),
+            }
+            .map_err(|e| e.at_origin(origin))?;
             if !self.assembly_reported {
                 use crate::mechanics::multibody::Equations;
                 let placed = system.initial_coordinates()?;
@@ -440,9 +462,9 @@ impl Engine {
                 self.inertias = Some(inertias);
             }
             // what was recorded past the state restored is not this run's
-            self.chords.retain(|(t, _)| *t <= state.t);
+            self.chords.retain(|(t, _)| *t <= origin);
             for p in &mut self.probes {
-                if p.as_ref().is_some_and(|p| p.t > state.t) {
+                if p.as_ref().is_some_and(|p| p.t > origin) {
                     *p = None;
                 }
             }
@@ -468,6 +490,8 @@ impl Engine {
             };
             let shape = crate::unit::shape::ShapeMaps::build(&scene, &self.effects, &system);
             self.model = Some(Model {
+                origin,
+                time: origin,
                 shape,
                 applied_inputs: flat_inputs(&system),
                 applied_loads: self.wanted_loads(),
@@ -485,21 +509,6 @@ impl Engine {
         Ok(self.model.as_mut().expect("model built above"))
     }
 
-    /// fmi2SetupExperiment / fmi2EnterInitializationMode: the start time of the run.
-    pub fn set_start_time(&mut self, t0: f64) -> Result<(), EngineError> {
-        if !t0.is_finite() {
-            return Err(EngineError::NonFiniteValue {
-                name: "startTime".into(),
-                value: t0,
-            });
-        }
-        if self.start_time != t0 {
-            self.start_time = t0;
-            self.model = None;
-        }
-        Ok(())
-    }
-
     /// fmi2ExitInitializationMode: builds the model and fixes the fixed parameters.
     pub fn exit_initialization(&mut self) -> Result<(), EngineError> {
         self.built()?;
@@ -514,28 +523,34 @@ impl Engine {
                 message: "the instance is not initialized".into(),
             });
         }
-        if !(h.is_finite() && h > 0.0) {
-            return Err(EngineError::BadStep {
-                message: format!("communicationStepSize = {h} must be positive and finite"),
-            });
-        }
         let now = self.time();
-        if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
+        let end = self.step_end(t, h, now)?;
+        // what the master saw at `now`: a failed step gives it back, also where the inputs'
+        // change had the integrator land on `now` from past it first
+        let m = self.built()?;
+        let saved = m.save();
+        // the step in the system's time (from the run's start): exact where the start time and
+        // the end are within a factor of 2 (Sterbenz), and never shorter than the time moves
+        let (tau_now, tau_end) = (m.state.t, end - m.origin);
+        if tau_end <= tau_now {
             return Err(EngineError::BadStep {
                 message: format!(
-                    "currentCommunicationPoint = {t} differs from the instance time {now}"
+                    "communicationStepSize = {} s does not move the time counted from the start                      time {} s (at {} s): double precision cannot advance it; the unit did not step",
+                    crate::scene::Short(h),
+                    crate::scene::Short(m.origin),
+                    crate::scene::Short(tau_now)
                 ),
             });
         }
-        // what the master saw at `now`: a failed step gives it back, also where the inputs'
-        // change had the integrator land on `now` from past it first
-        let saved = self.built()?.save();
         self.probe_inputs();
-        let mut result = self.sync_inputs(now, h);
+        let mut result = self.sync_inputs(tau_now, h);
         let m = self.model.as_mut().expect("built above");
         if result.is_ok() {
-            result = m.advance(now + h);
+            result = m.advance(tau_end);
+            m.time = end;
         }
+        let origin = m.origin;
+        result = result.map_err(|e| e.at_origin(origin));
         if result.is_ok() {
             result = self.monitor_validity();
         }
@@ -562,6 +577,7 @@ impl Engine {
         let Some((t, h, why)) = m.stepper.last_split else {
             return;
         };
+        let t = m.origin + t;
         if m.stats.split == before || self.split_reported.contains(&why) {
             return;
         }

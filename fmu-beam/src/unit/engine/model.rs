@@ -95,6 +95,7 @@ impl Model {
 
     pub(super) fn save(&self) -> ModelState {
         ModelState {
+            time: self.time,
             state: self.state.clone(),
             front: self.front.clone(),
             back: self.back.clone(),
@@ -106,6 +107,7 @@ impl Model {
     }
 
     pub(super) fn put_back(&mut self, s: ModelState) {
+        self.time = s.time;
         self.state = s.state;
         self.front = s.front;
         self.back = s.back;

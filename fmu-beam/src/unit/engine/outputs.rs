@@ -90,7 +90,7 @@ pub(super) fn common_output(m: &Model, kind: OutputKind) -> f64 {
             m.system.constraints(&m.front.q, m.front.t, &mut g);
             g.amax()
         }
-        K::NextEventTime => crate::unit::interface::next_event_time(&m.system, st.t),
+        K::NextEventTime => m.origin + crate::unit::interface::next_event_time(&m.system, st.t),
         K::Shape { beam, point, axis } => m.shape.point(&m.system, &st.q, beam, point)[axis],
         K::BeamAxis(g, axis) => crate::unit::shape::axis(&m.system, &st.q, g)[axis],
         // no other output is offered by a scene whose system lacks it

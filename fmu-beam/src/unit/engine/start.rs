@@ -13,13 +13,14 @@ use nalgebra::DVector;
 /// Coordinates q and velocities q' at the start.
 type Start = (DVector<f64>, DVector<f64>);
 
-/// The coordinates and velocities at `t0` of `system` (built from `scene`, its inputs set) that
-/// meet the joints' initial coordinates and rates, or `None` if the scene gives none.
+/// The coordinates and velocities at the start of `system` (built from `scene`, its inputs set,
+/// its time 0 at absolute time `origin`) that meet the joints' initial coordinates and rates,
+/// or `None` if the scene gives none.
 pub(super) fn given(
     scene: &Scene,
     effects: &Effects,
     system: &Mechanics,
-    t0: f64,
+    origin: f64,
 ) -> Result<Option<Start>, EngineError> {
     let gives = |j: &crate::scene::JointSpec| {
         j.initial
@@ -57,6 +58,7 @@ pub(super) fn given(
         listed.push((j.name.clone(), start));
     }
     let mut twin_system = Mechanics::build(&twin, effects);
+    twin_system.set_time_origin(origin);
     // the inputs as set now, by name (a joint's input effort drive is not in the twin)
     let slots = input_slots(scene);
     for (k, slot) in input_slots(&twin).iter().enumerate() {
@@ -80,5 +82,5 @@ pub(super) fn given(
             speed: start.speed,
         });
     }
-    integrator::given_start(&twin_system, t0, &starts).map(Some)
+    integrator::given_start(&twin_system, 0.0, &starts).map(Some)
 }

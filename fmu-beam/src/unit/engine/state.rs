@@ -8,7 +8,7 @@ use crate::error::EngineError;
 use crate::integrator::{write_vec, GaState, Memory, Reader, Stats};
 
 const STATE_MAGIC: &[u8; 8] = b"FMUBEAM\0";
-const STATE_VERSION: u32 = 7;
+const STATE_VERSION: u32 = 8;
 
 /// FNV-1a (64 bit) of `bytes` from `seed`: the scene's fingerprint and the serialized state's
 /// checksum. Any one changed byte changes it (each step is a bijection of the running value).
@@ -49,7 +49,12 @@ impl Engine {
             self.model.take(),
             std::mem::replace(&mut self.initialized, false),
         );
-        let result = self.put_back_model(s);
+        let result = self
+            .check_experiment(s.start_time, None)
+            .map_err(|e| EngineError::BadState {
+                message: format!("its start time: {e}"),
+            })
+            .and_then(|()| self.put_back_model(s));
         match result {
             Ok(()) => self.initialized = s.initialized,
             Err(_) => {
@@ -91,6 +96,11 @@ impl Engine {
                 message: "the state has another number of inputs or tunable loads".into(),
             });
         }
+        if let Some(why) = implausible(m, saved) {
+            return Err(EngineError::BadState {
+                message: format!("it is no state of this model: {why}"),
+            });
+        }
         m.put_back(saved.clone());
         Ok(())
     }
@@ -121,6 +131,7 @@ impl Engine {
             None => w.push(0),
             Some(ms) => {
                 w.push(1);
+                w.extend_from_slice(&ms.time.to_le_bytes());
                 ms.state.write(&mut w);
                 ms.front.write(&mut w);
                 match &ms.back {
@@ -187,6 +198,7 @@ impl Engine {
         let model = match r.u8()? {
             0 => None,
             1 => {
+                let time = r.f64()?;
                 let state = GaState::read(&mut r)?;
                 let front = GaState::read(&mut r)?;
                 let back = match r.u8()? {
@@ -195,6 +207,7 @@ impl Engine {
                     _ => return Err(bad("corrupt flag")),
                 };
                 Some(ModelState {
+                    time,
                     state,
                     front,
                     back,
@@ -231,13 +244,73 @@ impl Engine {
                 return Err(bad("non-finite values in the integration state"));
             }
         }
-        Ok(Snapshot {
+        let snapshot = Snapshot {
             identity: self.fingerprint(),
             initialized,
             start_time,
             values,
             input_ders,
             model,
-        })
+        };
+        // checked as fmi2SetFMUstate will check it (on a copy: this instance stays as it is),
+        // so that a state no restore takes is refused when read
+        self.clone().restore(&snapshot)?;
+        Ok(snapshot)
     }
+}
+
+/// Why `saved` cannot be a state of the model `m` built from its parameter values, if it
+/// cannot: its times not those of a run from `m`'s start (the communication point at or after
+/// the start, the system's time its distance from the start, the integrator at most one
+/// largest step past it and the step before at most there), or a state or the integrator's
+/// memory implausible for `m`'s system (`Stepper::implausible`: coordinates, rates and
+/// multipliers within bounds, the proposed step within the stepper's, the joints closed).
+fn implausible(m: &Model, saved: &ModelState) -> Option<String> {
+    use crate::scene::Short;
+    let (time, st, front) = (saved.time, &saved.state, &saved.front);
+    if !(time.is_finite() && time >= m.origin) {
+        return Some(format!(
+            "its time {} s is not a finite time at or after its start {} s",
+            Short(time),
+            Short(m.origin)
+        ));
+    }
+    let since = time - m.origin;
+    if !crate::integrator::within(st.t - since, 2.0 * super::times::resolution(time)) {
+        return Some(format!(
+            "its time since the start, {} s, is not its time {} s less its start {} s",
+            Short(st.t),
+            Short(time),
+            Short(m.origin)
+        ));
+    }
+    let largest = crate::scene::MAX_STEP;
+    let ahead = front.t - st.t;
+    if !(ahead >= -1e-6 * largest && ahead <= largest) {
+        return Some(format!(
+            "the integrator is {} s from the communication point, beyond one largest step ({} s)",
+            Short(ahead),
+            Short(largest)
+        ));
+    }
+    if let Some(back) = &saved.back {
+        if !(back.t <= front.t && st.t - back.t <= largest) {
+            return Some("the state before the integrator's last step is not before it".into());
+        }
+    }
+    let sys = &m.system;
+    let stepper = &m.stepper;
+    stepper
+        .implausible(sys, st, "the state at the communication point", false)
+        .or_else(|| stepper.implausible(sys, front, "the integrator's state", true))
+        .or_else(|| {
+            let back = saved.back.as_ref()?;
+            stepper.implausible(
+                sys,
+                back,
+                "the state before the integrator's last step",
+                true,
+            )
+        })
+        .or_else(|| stepper.implausible_memory(sys, &saved.memory, front.t))
 }

@@ -17,7 +17,7 @@ impl Engine {
     /// beam's chord (root to tip) is longer than the beam. A good state's chords are kept.
     pub(super) fn monitor_validity(&mut self) -> Result<(), EngineError> {
         let m = self.model.as_ref().expect("model built");
-        let t = m.state.t;
+        let t = m.time;
         let beams = beam_states(m);
         for (g, beam) in beams.iter().enumerate() {
             let frames = beam.frames.iter().map(|(n, l, d)| (n.as_str(), *l, *d));
