@@ -519,8 +519,7 @@ pub fn write(
         let count = gif::write(&frames, &view, magnification, options, path)?;
         if let Some(meta) = &options.metadata {
             let text = view.metadata(&frames, magnification, options.fps);
-            std::fs::write(meta, text)
-                .map_err(|e| crate::HarnessError::io(meta, "writing the GIF's metadata", e))?;
+            crate::output_file::write_atomically(meta, text.as_bytes())?;
         }
         written.push(Written {
             path: path.clone(),
@@ -532,8 +531,7 @@ pub fn write(
     if let Some(path) = &options.html {
         let started = std::time::Instant::now();
         let text = html::page(motion, magnification, options.speed);
-        std::fs::write(path, &text)
-            .map_err(|e| crate::HarnessError::io(path, "writing the page", e))?;
+        crate::output_file::write_atomically(path, text.as_bytes())?;
         written.push(Written {
             path: path.clone(),
             bytes: text.len() as u64,
