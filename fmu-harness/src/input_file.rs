@@ -34,7 +34,8 @@ pub enum InputFileError {
 }
 
 impl InputFileError {
-    fn of(e: FileRefusal, path: &Path, what: &'static str) -> InputFileError {
+    /// A refusal of the engine's reader ([`files`]), for the file `path`, `what` in words.
+    pub fn of(e: FileRefusal, path: &Path, what: &'static str) -> InputFileError {
         let path = path.to_path_buf();
         match e {
             FileRefusal::NotRegular { kind } => InputFileError::NotRegular { path, what, kind },
@@ -60,6 +61,15 @@ impl InputFileError {
 /// regular file, more than `limit` bytes, unreadable.
 pub fn read(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u8>, InputFileError> {
     files::read_bytes(path, limit).map_err(|e| InputFileError::of(e, path, what))
+}
+
+/// The regular file at `path` open for reading (`what` names it in messages: "the FMU"),
+/// checked without blocking ([`files::open_regular`]): a FIFO or a device is refused, not
+/// opened. No cap: the caller bounds what it reads.
+pub fn open(path: &Path, what: &'static str) -> Result<std::fs::File, InputFileError> {
+    files::open_regular(path, u64::MAX)
+        .map(|(f, _)| f)
+        .map_err(|e| InputFileError::of(e, path, what))
 }
 
 /// [`read`], as UTF-8 text (refused, without quoting it, if it is not).

@@ -148,10 +148,12 @@ pub fn kind_of(t: std::fs::FileType) -> &'static str {
     "special file"
 }
 
-/// The bytes of the regular file at `path`, at most `cap`: its type and size are checked
-/// before it is opened (a FIFO or a device is refused without being opened), it is opened
-/// non-blocking, checked again on the open handle, and the read stops one byte past the cap.
-pub fn read_bytes(path: &Path, cap: u64) -> Result<Vec<u8>, FileRefusal> {
+/// The regular file at `path`, open for reading, of at most `cap` bytes by its size: its type
+/// and size are checked before it is opened (a FIFO or a device is refused without being
+/// opened), it is opened non-blocking, and checked again on the open handle (the path may
+/// have been swapped in between). What every reader of a named file opens it with: this
+/// module's readers, the harness's (`input_file`) and its FMU archives.
+pub fn open_regular(path: &Path, cap: u64) -> Result<(std::fs::File, u64), FileRefusal> {
     let meta = std::fs::metadata(path).map_err(io)?;
     let check = |meta: &std::fs::Metadata| {
         if !meta.is_file() {
@@ -171,14 +173,20 @@ pub fn read_bytes(path: &Path, cap: u64) -> Result<Vec<u8>, FileRefusal> {
     {
         use std::os::unix::fs::OpenOptionsExt;
         // O_NONBLOCK: a FIFO put there since the first look opens at once instead of waiting
-        // for a writer (and is refused by the second look)
+        // for a writer (and is refused by the second look); a regular file reads as usual
         options.custom_flags(0o4000);
     }
     let file = options.open(path).map_err(io)?;
-    // the file may have been swapped between the two looks: look again at what was opened
     let meta = file.metadata().map_err(io)?;
     check(&meta)?;
-    let mut bytes = Vec::with_capacity(meta.len().min(cap) as usize);
+    Ok((file, meta.len()))
+}
+
+/// The bytes of the regular file at `path`, at most `cap` ([`open_regular`]); the read stops
+/// one byte past the cap, whatever size the file system reported.
+pub fn read_bytes(path: &Path, cap: u64) -> Result<Vec<u8>, FileRefusal> {
+    let (file, len) = open_regular(path, cap)?;
+    let mut bytes = Vec::with_capacity(len.min(cap) as usize);
     file.take(cap.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(io)?;

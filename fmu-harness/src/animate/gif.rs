@@ -122,7 +122,7 @@ fn encode(
         message,
     };
     let (w, h) = (view.width, view.height);
-    if !(16..=4096).contains(&w) || !(16..=4096).contains(&h) {
+    if !super::GIF_SIDES.contains(&w) || !super::GIF_SIDES.contains(&h) {
         return Err(AnimateError::BadOption {
             name: "--size",
             value: format!("{w}x{h}"),

@@ -429,6 +429,24 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
     // every file it would write is looked at before the run
     let outputs = [&output, &gif, &csv, &metadata];
     crate::output_file::check_all(outputs.iter().filter_map(|p| p.as_deref()))?;
+    let options = animate::Options {
+        html: output,
+        gif,
+        metadata,
+        fps,
+        speed,
+        magnification: magnify,
+        width,
+        height,
+    };
+    // and the work it would do: the options, the recorded times and frames of a run made here
+    animate::check_options(&options)?;
+    let planned = animate::planned_experiment(&run, stop, step)?;
+    // (an experiment that is no interval is refused by the run, saying so)
+    if let Some((start, stop, step)) = planned.filter(|(a, b, h)| b > a && *h > 0.0) {
+        animate::check_recorded_times(start, stop, step)?;
+        animate::check_frames(stop - start, &options)?;
+    }
     let started = std::time::Instant::now();
     let mut scenes: Vec<animate::KnownScene> = scene
         .iter()
@@ -440,16 +458,6 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
         crate::output_file::write_atomically(path, recording.csv().as_bytes())?;
     }
     let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
-    let options = animate::Options {
-        html: output,
-        gif,
-        metadata,
-        fps,
-        speed,
-        magnification: magnify,
-        width,
-        height,
-    };
     let (m, written) = animate::write(&motion, &options)?;
     writeln!(
         out,
