@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -162,6 +162,17 @@ FUZZ_SEED    ?= 45
 FUZZ_SECONDS ?= 120
 fuzz: .venv release
 	nice $(PY) tests/fuzz/fmi_calls.py --engine $(ENGINE) --harness $(HARNESS) --seed $(FUZZ_SEED) --seconds $(FUZZ_SECONDS)
+
+# The fuzz stage's Python half (issue 45, item 9): hostile Python objects (self-reference, deep
+# nesting, hostile tolist/items/__str__/__float__/__index__, subclasses with lying methods, huge
+# ints, NaN, bytes, sets, generators) thrown at Scene.from_dict, from_toml, load, package, modes,
+# simulate and the command, seeded and bounded in time (tests/fuzz/python_objects.py, about
+# FUZZ_PYTHON_SECONDS, some 20 cases a second); a crash, a hang or an internal error fails it.
+# It uses the fmu_beam installed in .venv (`make wheel`).
+FUZZ_PYTHON_SEED    ?= 45
+FUZZ_PYTHON_SECONDS ?= 60
+fuzz-python: .venv
+	nice $(PY) tests/fuzz/python_objects.py --seed $(FUZZ_PYTHON_SEED) --seconds $(FUZZ_PYTHON_SECONDS)
 
 # C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus

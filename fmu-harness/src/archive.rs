@@ -1,10 +1,11 @@
 //! The FMU archive: a zip written byte-for-byte reproducibly (fixed entry order, timestamps of
 //! 1980-01-01 00:00, fixed permissions, deflate level 6) and atomically (a temporary file in the
-//! same directory, renamed over the target only when complete).
+//! same directory, renamed over the target only when complete, and never over what is not a
+//! regular file: [`crate::output_file`]).
 
 use crate::error::HarnessError;
 use std::io::{Cursor, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
@@ -45,44 +46,6 @@ pub fn write_fmu(out: &Path, entries: &[Entry]) -> Result<(), HarnessError> {
     write_atomically(out, &bytes)
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), HarnessError> {
-    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
-        return Err(HarnessError::BadOutput {
-            path: path.to_path_buf(),
-        });
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| HarnessError::BadOutput {
-            path: path.to_path_buf(),
-        })?
-        .to_string_lossy()
-        .into_owned();
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| HarnessError::io(&dir, "creating the output directory", e))?;
-    let tmp = TempFile(dir.join(format!(".{name}.tmp-{}", std::process::id())));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp.0)?;
-        f.write_all(bytes)?;
-        f.sync_all()
-    };
-    write().map_err(|e| HarnessError::io(&tmp.0, "writing the FMU", e))?;
-    std::fs::rename(&tmp.0, path)
-        .map_err(|e| HarnessError::io(path, "moving the FMU in place", e))?;
-    std::mem::forget(tmp);
-    Ok(())
-}
-
-/// A temporary file removed when dropped (that is, unless the write completed).
-struct TempFile(PathBuf);
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
+/// The writer of every output ([`crate::output_file::write_atomically`]), here where the FMU
+/// archive first needed it.
+pub use crate::output_file::write_atomically;

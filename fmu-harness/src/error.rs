@@ -100,8 +100,15 @@ pub enum HarnessError {
         of: usize,
         missing: Vec<&'static str>,
     },
-    #[error("{}: not a file path for the FMU (give one such as build/fmus/<scene>.fmu)", .path.display())]
+    #[error("{}: not a path to a file (give one such as build/fmus/<scene>.fmu or run.csv)", .path.display())]
     BadOutput { path: PathBuf },
+    /// An output that is there and is not a regular file (issue 45): never replaced.
+    #[error(
+        "{}: a {kind}; an output must be a regular file or a new name (it is never written \
+         through a link, nor over a FIFO, device or directory)",
+        .path.display()
+    )]
+    NotRegularOutput { path: PathBuf, kind: &'static str },
 }
 
 /// Which FMI 2.0 functions a `--binary` does not export.

@@ -1,109 +1,75 @@
-//! A file named to the harness, read with care (issue 35, item 2): it must be a regular file
-//! (its type is checked from the metadata before opening and again on the open file, opened
+//! A file named to the harness, read with care (issue 35, item 2; issue 45): through the
+//! engine's one reader, [`fmu_beam::scene::files::read_bytes`]. It must be a regular file (its
+//! type is checked from the metadata before opening and again on the open file, opened
 //! non-blocking, so that a FIFO or a device is refused at once instead of blocking or reading
-//! forever), and no more than a cap is read, whatever size the file system reports.
+//! forever), and no more than a cap is read, whatever size the file system reports. A refusal
+//! names the path as the user gave it and tells nothing of the file's bytes or size.
 
-use std::io::Read;
+use fmu_beam::scene::files::{self, FileRefusal};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum InputFileError {
-    #[error("{}: {action}: {source}", .path.display())]
+    #[error("{}: {action}: {message}", .path.display())]
     Io {
         path: PathBuf,
         action: &'static str,
-        source: std::io::Error,
+        message: String,
     },
-    #[error("{}: {kind}; {what} must be a regular file", .path.display())]
+    #[error("{}: a {kind}; {what} must be a regular file", .path.display())]
     NotRegular {
         path: PathBuf,
         what: &'static str,
         kind: &'static str,
     },
-    #[error("{}: {bytes} bytes or more; {what} may have at most {limit}", .path.display())]
+    #[error("{}: larger than {limit} bytes, the most {what} may have", .path.display())]
     TooLarge {
         path: PathBuf,
         what: &'static str,
-        bytes: u64,
         limit: u64,
     },
     #[error("{}: {what} must be UTF-8 text, and is not", .path.display())]
     NotText { path: PathBuf, what: &'static str },
 }
 
-/// What a file that is not a regular file is, for messages.
-fn file_kind(t: std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
+impl InputFileError {
+    /// A refusal of the engine's reader ([`files`]), for the file `path`, `what` in words.
+    pub fn of(e: FileRefusal, path: &Path, what: &'static str) -> InputFileError {
+        let path = path.to_path_buf();
+        match e {
+            FileRefusal::NotRegular { kind } => InputFileError::NotRegular { path, what, kind },
+            FileRefusal::TooLarge { cap } => InputFileError::TooLarge {
+                path,
+                what,
+                limit: cap,
+            },
+            FileRefusal::NotText => InputFileError::NotText { path, what },
+            other => InputFileError::Io {
+                path,
+                action: "reading",
+                message: match other {
+                    FileRefusal::Io { message } => message,
+                    o => o.to_string(),
+                },
+            },
         }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a folder"
-    } else {
-        "not a regular file"
     }
 }
 
 /// The bytes of `path` (`what` names it in messages: "an engine library"), or why not: not a
 /// regular file, more than `limit` bytes, unreadable.
 pub fn read(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u8>, InputFileError> {
-    let not_regular = |t: std::fs::FileType| InputFileError::NotRegular {
-        path: path.to_path_buf(),
-        what,
-        kind: file_kind(t),
-    };
-    let too_large = |bytes: u64| InputFileError::TooLarge {
-        path: path.to_path_buf(),
-        what,
-        bytes,
-        limit,
-    };
-    let io = |source| InputFileError::Io {
-        path: path.to_path_buf(),
-        action: "reading",
-        source,
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    if meta.len() > limit {
-        return Err(too_large(meta.len()));
-    }
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        // O_NONBLOCK: a FIFO put there since the check opens at once instead of waiting.
-        options.custom_flags(0o4000);
-    }
-    let file = options.open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len().min(limit) as usize);
-    file.take(limit.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    files::read_bytes(path, limit).map_err(|e| InputFileError::of(e, path, what))
+}
+
+/// The regular file at `path` open for reading (`what` names it in messages: "the FMU"),
+/// checked without blocking ([`files::open_regular`]): a FIFO or a device is refused, not
+/// opened. No cap: the caller bounds what it reads.
+pub fn open(path: &Path, what: &'static str) -> Result<std::fs::File, InputFileError> {
+    files::open_regular(path, u64::MAX)
+        .map(|(f, _)| f)
+        .map_err(|e| InputFileError::of(e, path, what))
 }
 
 /// [`read`], as UTF-8 text (refused, without quoting it, if it is not).
@@ -147,6 +113,8 @@ mod tests {
             .to_string()
             .contains("a character device; a test file must be a regular file"));
         let e = read(Path::new("/"), "a test file", 10).unwrap_err();
-        assert!(e.to_string().contains("a folder"));
+        assert!(e
+            .to_string()
+            .contains("a directory; a test file must be a regular file"));
     }
 }

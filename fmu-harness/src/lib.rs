@@ -22,6 +22,7 @@ pub mod log_categories;
 pub mod log_format;
 pub mod model_description;
 pub mod modes;
+pub mod output_file;
 pub mod package;
 pub mod platform;
 pub mod reference;

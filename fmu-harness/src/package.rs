@@ -235,6 +235,8 @@ pub fn package_scene(
     output: &Path,
     binaries: &[BinaryArg],
 ) -> Result<Packaged, HarnessError> {
+    // an output that would be refused is refused before the work
+    crate::output_file::check(output)?;
     let given = if binaries.is_empty() {
         vec![BinaryArg {
             platform: None,

@@ -201,10 +201,7 @@ fn hostile_files_and_sizes_are_refused_by_package() {
         refused_within(
             &args,
             5.0,
-            &[
-                "beam \"beam\".matrix_file",
-                "below the scene file's directory",
-            ],
+            &["beam \"beam\".matrix_file", "below the scene's directory"],
         );
         assert!(!out.exists(), "{case}: an FMU was written");
     }

@@ -68,16 +68,23 @@ class Scene:
         """Reads and validates a scene file (TOML) as ``fmu-beam package`` does; a beam's
         ``matrix_file`` is read relative to the file. Raises :class:`SceneError`."""
     @staticmethod
-    def from_toml(text: str, origin: str = "<string>") -> "Scene":
-        """Parses and validates scene text (TOML); ``origin`` prefixes the messages."""
+    def from_toml(
+        text: str, origin: str = "<string>", directory: Optional[StrPath] = None
+    ) -> "Scene":
+        """Parses and validates scene text (TOML); ``origin`` prefixes the messages. A beam's
+        ``matrix_file`` is read below ``directory`` (default: the working directory), as
+        ``from_dict`` reads it."""
     @staticmethod
     def from_dict(
         d: Mapping[str, Any], origin: str = "<dict>", directory: Optional[StrPath] = None
     ) -> "Scene":
         """Builds a scene from nested dicts and lists shaped like the TOML file (the scene
         reference applies key for key; a key set to None takes its default) and validates it as
-        the packager does. A beam's ``matrix_file`` is read relative to ``directory`` (default:
-        the working directory). Raises :class:`SceneError` naming the field."""
+        the packager does. A beam's ``matrix_file`` is read below ``directory`` (default: the
+        working directory) by the engine's one reader: a regular file there, links followed but
+        not out of it, capped. Any object is refused rather than crash: nested more than 64
+        deep, holding itself, or larger than a scene file may be. Raises :class:`SceneError`
+        naming the field."""
     @property
     def name(self) -> str:
         """The scene's name: the FMU's modelIdentifier."""
@@ -112,7 +119,9 @@ class Scene:
     ) -> Packaged:
         """Writes the scene's FMU to ``path`` with this package's engines of ``platforms``
         ('linux64', 'win64'; default: all it carries), or with the engine libraries of
-        ``binaries`` ({'linux64': path, ...}, like ``--binary``)."""
+        ``binaries`` ({'linux64': path, ...}, like ``--binary``). ``path`` must be a new name
+        or a regular file, replaced whole; a FIFO, device, directory or symbolic link there is
+        refused (:class:`Error`) and left as it was."""
     def simulate(
         self,
         stop_time: Optional[float] = None,

@@ -11,7 +11,7 @@ use fmu_harness::HarnessError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A validated scene: loaded from a file, read from TOML text, or built from a dict.
 #[pyclass(frozen, module = "fmu_beam", name = "Scene")]
@@ -48,12 +48,21 @@ impl PyScene {
         Ok(PyScene { scene, origin })
     }
 
-    /// Parses and validates scene text (TOML); `origin` prefixes the messages.
+    /// Parses and validates scene text (TOML); `origin` prefixes the messages. A beam's
+    /// `matrix_file` is read below `directory` (default: the working directory), as
+    /// `from_dict` reads it.
     #[staticmethod]
-    #[pyo3(signature = (text, origin = "<string>"))]
-    fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyScene> {
-        let scene =
-            guard(|| Scene::from_toml_str(text, origin).map_err(|e| Refusal::of(&e).into_err(py)))?;
+    #[pyo3(signature = (text, origin = "<string>", directory = None))]
+    fn from_toml(
+        py: Python<'_>,
+        text: &str,
+        origin: &str,
+        directory: Option<PathBuf>,
+    ) -> PyResult<PyScene> {
+        let dir = directory.unwrap_or_else(|| PathBuf::from("."));
+        let scene = guard(|| {
+            Scene::from_toml_in(text, origin, &dir).map_err(|e| Refusal::of(&e).into_err(py))
+        })?;
         Ok(PyScene {
             scene,
             origin: origin.to_string(),
@@ -62,8 +71,11 @@ impl PyScene {
 
     /// Builds a scene from nested dicts and lists shaped like the TOML file (the scene
     /// reference applies key for key; a key set to None takes its default) and validates it as
-    /// the packager does. A beam's `matrix_file` is read relative to `directory` (default: the
-    /// working directory). Raises SceneError naming the field.
+    /// the packager does. A beam's `matrix_file` is read below `directory` (default: the
+    /// working directory) by the engine's one reader: a regular file there, links followed
+    /// but not out of it, capped. Any object is refused (SceneError) rather than crash: nested
+    /// more than 64 deep, holding itself, or larger than a scene file may be. Raises
+    /// SceneError naming the field.
     #[staticmethod]
     #[pyo3(signature = (d, origin = "<dict>", directory = None))]
     fn from_dict(
@@ -74,7 +86,7 @@ impl PyScene {
     ) -> PyResult<PyScene> {
         guard(|| {
             let value = convert::to_toml(d, "", origin).map_err(|r| (*r).into_err(py))?;
-            let toml::Value::Table(mut table) = value else {
+            let toml::Value::Table(table) = value else {
                 return Err(Refusal {
                     message: format!("{origin}: a scene is a dict of its tables and keys"),
                     origin: origin.to_string(),
@@ -83,9 +95,8 @@ impl PyScene {
                 }
                 .into_err(py));
             };
-            read_matrix_files(&mut table, directory.as_deref(), origin)
-                .map_err(|r| (*r).into_err(py))?;
-            let scene = Scene::from_toml_str(&toml_text(&table), origin)
+            let dir = directory.unwrap_or_else(|| PathBuf::from("."));
+            let scene = Scene::from_toml_in(&toml_text(&table), origin, &dir)
                 .map_err(|e| refusal_in_dict(&e, &table).into_err(py))?;
             Ok(PyScene {
                 scene,
@@ -298,57 +309,6 @@ fn engine_args(
 /// The text of a table built from a dict (TOML serializes every table of ours).
 fn toml_text(table: &toml::Table) -> String {
     toml::to_string(table).unwrap_or_default()
-}
-
-/// A beam's `matrix_file` read into its `matrix_text` (relative to `directory`), as
-/// `Scene::load` does for a file.
-fn read_matrix_files(
-    table: &mut toml::Table,
-    directory: Option<&Path>,
-    origin: &str,
-) -> Result<(), Box<Refusal>> {
-    let Some(toml::Value::Array(beams)) = table.get_mut("beam") else {
-        return Ok(());
-    };
-    let names: Vec<String> = beams
-        .iter()
-        .map(|t| {
-            t.get("name")
-                .and_then(toml::Value::as_str)
-                .unwrap_or("")
-                .to_string()
-        })
-        .collect();
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    for (i, beam) in beams.iter_mut().enumerate() {
-        let toml::Value::Table(b) = beam else {
-            continue;
-        };
-        if b.contains_key("matrix_text") {
-            continue;
-        }
-        let Some(toml::Value::String(file)) = b.get("matrix_file") else {
-            continue;
-        };
-        let path = directory.unwrap_or(Path::new(".")).join(file);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            let field = format!(
-                "{}.matrix_file",
-                fmu_beam::scene::part_path("beam", i, &names)
-            );
-            let rule = format!("cannot read {}: {e}", path.display());
-            Box::new(Refusal {
-                message: format!("{origin}: field `{field}` = {file:?}: {rule}"),
-                origin: origin.to_string(),
-                field: Some(field),
-                value: Some(format!("{file:?}")),
-                rule: Some(rule),
-                code: None,
-            })
-        })?;
-        b.insert("matrix_text".into(), toml::Value::String(text));
-    }
-    Ok(())
 }
 
 /// The refusal of a scene built from a dict. A value refused by a rule is the packager's

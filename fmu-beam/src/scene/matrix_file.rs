@@ -22,9 +22,9 @@
 //! The file, the line and column, and what was expected there; of the text itself, only a
 //! word of at most [`QUOTED`] characters of digits, letters, `.`, `+`, `-` and `_`, and only
 //! where the file has shown itself a matrix file (a number of a block, the value after
-//! `length`) or where it misspells a keyword. A file that is not one (a scene naming
-//! `/etc/shadow` by mistake or by malice) is refused with its first line and column and
-//! nothing of its content.
+//! `length`) or where it misspells a keyword; any other word is neither quoted nor measured.
+//! A file that is not one (a scene naming `/etc/shadow` by mistake or by malice) is refused
+//! with its first line and column and nothing of its content, not even a word's length.
 //!
 //! # Rules (each refusal names the file, the line and the rule)
 //! - symmetric: |a_ij − a_ji| ≤ [`SYMMETRY_TOLERANCE`] · max |a| (relative to the largest
@@ -165,16 +165,15 @@ pub enum MatrixFileError {
 }
 
 /// A word of the file as a message may show it: quoted if short and made of the characters of
-/// numbers and keywords, else only its length.
+/// numbers and keywords, else not at all (not even its length: issue 45).
 fn shown(word: &str) -> String {
-    let n = word.chars().count();
     let plain = word
         .chars()
         .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '+' | '-' | '_'));
-    if plain && n <= QUOTED {
+    if plain && word.chars().count() <= QUOTED {
         format!("`{word}`")
     } else {
-        format!("a word of {n} characters")
+        "a word (not shown)".to_string()
     }
 }
 
@@ -348,7 +347,7 @@ pub fn parse(text: &str, file: &str) -> Result<MatrixFile, MatrixFileError> {
                 let found = if near {
                     shown(first)
                 } else {
-                    format!("a word of {} characters", first.chars().count())
+                    "(not shown)".to_string()
                 };
                 return Err(syntax(
                     line,
@@ -511,5 +510,34 @@ impl MatrixFile {
             }
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 45: a file that is not a matrix file (/proc/self/environ, a secrets file named by
+    /// mistake or by malice) was refused with the length of its first word; a word inside a
+    /// block that is not shown had its length told too. Now neither says anything of the word.
+    #[test]
+    fn a_word_not_shown_is_not_measured_either() {
+        for text in [
+            "PATH=/usr/local/sbin:/usr/bin\0HOME=/root\0",
+            "root:$y$j9T$SECRETSECRETSECRET:19000:0:99999:7:::\n",
+            "token 0123456789abcdef\n",
+        ] {
+            let m = parse(text, "f.txt").unwrap_err().to_string();
+            assert!(!m.contains("characters") && !m.contains("SECRET"), "{m}");
+            for w in text.split(|c: char| !c.is_ascii_alphanumeric()) {
+                assert!(w.len() < 4 || !m.contains(w), "{w} in {m}");
+            }
+        }
+        let block = format!(
+            "length 1\nmass\n{} 1 1 1 1 1 1 1 1 1 1 1\n",
+            "x=".repeat(30)
+        );
+        let m = parse(&block, "f.txt").unwrap_err().to_string();
+        assert!(!m.contains("60") && !m.contains("characters"), "{m}");
     }
 }

@@ -744,7 +744,6 @@ impl Scene {
             return Err(SceneError::Io {
                 origin: origin.to_string(),
                 message: files::FileRefusal::TooLarge {
-                    size: text.len().to_string(),
                     cap: files::MAX_SCENE_BYTES,
                 }
                 .to_string(),
@@ -776,7 +775,7 @@ impl Scene {
     /// `matrix_text`, unless the text is there already. Each file is read only if it is a
     /// regular file within its cap ([`files::MAX_SCENE_BYTES`],
     /// [`files::MAX_MATRIX_FILE_BYTES`]); a matrix file must lie below the scene file's
-    /// directory (links followed, [`files::resolve_below`]).
+    /// directory ([`Scene::from_toml_in`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let origin = path.display().to_string();
         let text =
@@ -784,26 +783,35 @@ impl Scene {
                 origin: origin.clone(),
                 message: e.to_string(),
             })?;
-        let mut scene = Scene::parse(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
+        Scene::from_toml_in(&text, &origin, dir)
+    }
+
+    /// Parses and validates scene text whose beams' `matrix_file`s are read below `dir` (each
+    /// into its `matrix_text`, unless the text is there already) by the one reader of the files
+    /// a scene names, [`files::read_below`]: every entry point (`Scene::load`, the command
+    /// line, the Python package's `from_toml` and `from_dict`) reads them here.
+    pub fn from_toml_in(text: &str, origin: &str, dir: &Path) -> Result<Scene, SceneError> {
+        let mut scene = Scene::parse(text, origin)?;
+        // no file is read for a scene of too many beams (each may name one)
+        limits::parts(&validate::Checker { origin }, &scene)?;
         let names: Vec<String> = scene.beams.iter().map(|b| b.name.clone()).collect();
         let names: Vec<&str> = names.iter().map(String::as_str).collect();
         for (i, b) in scene.beams.iter_mut().enumerate() {
             // a packaged scene carries the text already
             if let (Some(file), None) = (&b.matrix_file, &b.matrix_text) {
                 let refuse = |e: files::FileRefusal| SceneError::File {
-                    origin: origin.clone(),
+                    origin: origin.to_string(),
                     field: format!("{}.matrix_file", part_path("beam", i, &names)),
                     file: limits::abbreviate(&format!("{file:?}"), 200),
                     rule: e.to_string(),
                 };
-                let resolved = files::resolve_below(dir, file).map_err(refuse)?;
                 let text =
-                    files::read_capped(&resolved, files::MAX_MATRIX_FILE_BYTES).map_err(refuse)?;
+                    files::read_below(dir, file, files::MAX_MATRIX_FILE_BYTES).map_err(refuse)?;
                 b.matrix_text = Some(text);
             }
         }
-        scene.validate(&origin)?;
+        scene.validate(origin)?;
         Ok(scene)
     }
 

@@ -1,6 +1,9 @@
 //! A study checked against the truth: a reference CSV (time first, then named columns, such as
 //! `bench/reference/`'s exact ANCF solutions) on the study's grid, and each run's true error in
-//! the study's norm, so that the estimates can be judged.
+//! the study's norm, so that the estimates can be judged. The file is read through the
+//! harness's bounded reader of regular files ([`crate::input_file`]); a refusal names its
+//! columns only when its first line is a header of plausible names over a row of numbers, and
+//! otherwise shows nothing of it.
 
 use super::estimate::{distances, peaks, Series};
 use super::{AccuracyError, Study};
@@ -9,6 +12,19 @@ use std::path::Path;
 /// The largest reference read (bench/reference/'s largest file is 95 kB; a million rows of a
 /// few outputs fit).
 pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
+
+/// Columns a refusal lists by name: more, and the header is not shown.
+const MAX_SHOWN_COLUMNS: usize = 50;
+
+/// A column name a refusal may show: an FMI-like name of at most 100 characters (letters,
+/// digits, `_`, `.`, `[`, `]`, `(`, `)`), starting with a letter or `_`.
+fn plausible_name(name: &str) -> bool {
+    name.len() <= 100
+        && name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '[' | ']' | '(' | ')'))
+}
 
 /// The reference's columns `columns`, one per output, on the grid `start + k comm`,
 /// k = 0..=n (the file may go on past it).
@@ -26,19 +42,35 @@ pub fn read(
     let text = crate::input_file::read_text(path, "the reference", MAX_REFERENCE_BYTES)
         .map_err(|e| bad(e.to_string()))?;
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let names: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| bad("empty".into()))?
+    let first = lines.next().ok_or_else(|| bad("empty".into()))?;
+    let names: Vec<&str> = first
         .split(',')
-        .map(str::trim)
+        .map(|c| c.trim().trim_matches('"'))
         .collect();
+    // the names are shown only when the file has shown itself a reference: plausible names
+    // over a row of as many numbers (issue 45: a file named by mistake or by malice is not
+    // quoted)
+    let second = lines.clone().next().unwrap_or("");
+    let numbers = second
+        .split(',')
+        .filter(|x| x.trim().parse::<f64>().is_ok())
+        .count();
+    let shown = (names.len() <= MAX_SHOWN_COLUMNS
+        && numbers == names.len()
+        && names.iter().all(|c| plausible_name(c)))
+    .then(|| names.join(", "));
     let idx: Vec<usize> = columns
         .iter()
         .map(|c| {
-            names
-                .iter()
-                .position(|n| n == c)
-                .ok_or_else(|| bad(format!("no column {c} (it has: {})", names.join(", "))))
+            names.iter().position(|n| n == c).ok_or_else(|| {
+                bad(match &shown {
+                    Some(list) => format!("no column {c} (it has: {list})"),
+                    None => format!(
+                        "no column {c}: its first line is not a header of column names over \
+                         rows of numbers (the file is not shown)"
+                    ),
+                })
+            })
         })
         .collect::<Result<_, _>>()?;
     let mut out: Series = vec![Vec::with_capacity(n + 1); columns.len()];

@@ -94,7 +94,8 @@ fn at(p: [f64; 2]) -> Point {
     Point::new(p[0].round() as i32, p[1].round() as i32)
 }
 
-/// Draws every frame of `frames` and writes the GIF; returns the number of frames.
+/// Draws every frame of `frames` and writes the GIF to `path`, whole or not at all
+/// ([`crate::output_file::write_through_temporary`]); returns the number of frames.
 pub fn write(
     frames: &Motion,
     view: &View,
@@ -102,12 +103,26 @@ pub fn write(
     options: &Options,
     path: &Path,
 ) -> Result<usize, crate::HarnessError> {
+    crate::output_file::write_through_temporary(path, "writing the GIF", |out| {
+        encode(frames, view, magnification, options, path, out)
+    })
+}
+
+/// [`write`] into `out`; `path` names the GIF in messages.
+fn encode(
+    frames: &Motion,
+    view: &View,
+    magnification: f64,
+    options: &Options,
+    path: &Path,
+    out: impl std::io::Write,
+) -> Result<usize, crate::HarnessError> {
     let fail = |message: String| AnimateError::Gif {
         path: path.into(),
         message,
     };
     let (w, h) = (view.width, view.height);
-    if !(16..=4096).contains(&w) || !(16..=4096).contains(&h) {
+    if !super::GIF_SIDES.contains(&w) || !super::GIF_SIDES.contains(&h) {
         return Err(AnimateError::BadOption {
             name: "--size",
             value: format!("{w}x{h}"),
@@ -115,11 +130,9 @@ pub fn write(
         }
         .into());
     }
-    let file = std::fs::File::create(path)
-        .map_err(|e| crate::HarnessError::io(path, "creating the GIF", e))?;
     let palette: Vec<u8> = PALETTE.iter().flatten().copied().collect();
-    let mut enc = gif::Encoder::new(std::io::BufWriter::new(file), w as u16, h as u16, &palette)
-        .map_err(|e| fail(e.to_string()))?;
+    let mut enc =
+        gif::Encoder::new(out, w as u16, h as u16, &palette).map_err(|e| fail(e.to_string()))?;
     enc.set_repeat(gif::Repeat::Infinite)
         .map_err(|e| fail(e.to_string()))?;
     let statics = Statics::of(frames, view);
@@ -156,10 +169,7 @@ pub fn write(
         enc.write_frame(&frame).map_err(|e| fail(e.to_string()))?;
         previous = Some(canvas.pixels.clone());
     }
-    enc.into_inner()
-        .map_err(|e| fail(e.to_string()))?
-        .into_inner()
-        .map_err(|e| fail(e.error().to_string()))?;
+    enc.into_inner().map_err(|e| fail(e.to_string()))?;
     Ok(frames.times.len())
 }
 

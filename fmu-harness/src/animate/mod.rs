@@ -15,12 +15,19 @@
 //! stays where it is. By default the factor makes the largest deflection of the run about
 //! 10 % of its beam's length (a round number, never below 1).
 
+mod bounds;
 pub mod gif;
 pub mod html;
 mod source;
 pub mod view;
 
-pub use source::{known_scene, packaged_scene, read_csv, run_fmu, run_scene, Recording};
+pub use bounds::{
+    check_frames, check_options, check_recorded_times, GIF_SIDES, MAX_FPS, MAX_FRAMES,
+    MAX_GIF_PIXELS, MAX_RECORDED_TIMES,
+};
+pub use source::{
+    known_scene, packaged_scene, planned_experiment, read_csv, run_fmu, run_scene, Recording,
+};
 
 use fmu_beam::scene::{JointKind, Scene};
 use std::path::PathBuf;
@@ -59,6 +66,34 @@ pub enum AnimateError {
     Gif { path: PathBuf, message: String },
     #[error("scene `{origin}` for the run: {message}")]
     Scene { origin: String, message: String },
+    /// The GIF would have too many frames or pixels, or none (issue 45): refused before
+    /// the run is made or drawn.
+    #[error(
+        "--speed {speed:e} and --fps {fps}: the GIF would have {frames:.4e} frames of \
+         {width} x {height} pixels ({span:e} s of run); {rule}"
+    )]
+    Frames {
+        frames: f64,
+        span: f64,
+        fps: f64,
+        speed: f64,
+        width: u32,
+        height: u32,
+        rule: String,
+    },
+    /// A run made here would record too many times (issue 45).
+    #[error(
+        "--stop {stop:e} and --step {step:e}: the run would record {times:.4e} times from \
+         {start:e} s; animate records at most {limit:e} recorded times: give a larger --step \
+         or a shorter --stop"
+    )]
+    TooManyTimes {
+        start: f64,
+        stop: f64,
+        step: f64,
+        times: f64,
+        limit: f64,
+    },
 }
 
 /// One beam's motion: `n` points per recorded time (world x, y, z) and its deflection axis.
@@ -491,22 +526,12 @@ pub fn write(
     motion: &Motion,
     options: &Options,
 ) -> Result<(f64, Vec<Written>), crate::HarnessError> {
-    let check = |name: &'static str, v: f64, rule: &'static str| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(AnimateError::BadOption {
-                name,
-                value: v.to_string(),
-                rule,
-            })
-        }
+    check_options(options)?;
+    let span = match (motion.times.first(), motion.times.last()) {
+        (Some(a), Some(b)) => b - a,
+        _ => 0.0,
     };
-    check("--fps", options.fps, "must be positive")?;
-    check("--speed", options.speed, "must be positive")?;
-    if let Some(m) = options.magnification {
-        check("--magnify", m, "must be positive (1: true scale)")?;
-    }
+    check_frames(span, options)?;
     let magnification = options
         .magnification
         .unwrap_or_else(|| motion.auto_magnification());
@@ -519,8 +544,7 @@ pub fn write(
         let count = gif::write(&frames, &view, magnification, options, path)?;
         if let Some(meta) = &options.metadata {
             let text = view.metadata(&frames, magnification, options.fps);
-            std::fs::write(meta, text)
-                .map_err(|e| crate::HarnessError::io(meta, "writing the GIF's metadata", e))?;
+            crate::output_file::write_atomically(meta, text.as_bytes())?;
         }
         written.push(Written {
             path: path.clone(),
@@ -532,8 +556,7 @@ pub fn write(
     if let Some(path) = &options.html {
         let started = std::time::Instant::now();
         let text = html::page(motion, magnification, options.speed);
-        std::fs::write(path, &text)
-            .map_err(|e| crate::HarnessError::io(path, "writing the page", e))?;
+        crate::output_file::write_atomically(path, text.as_bytes())?;
         written.push(Written {
             path: path.clone(),
             bytes: text.len() as u64,

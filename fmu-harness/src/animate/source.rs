@@ -88,13 +88,58 @@ pub fn read_csv(path: &Path) -> Result<Recording, HarnessError> {
     Ok(Recording { columns, values })
 }
 
+/// The experiment a run of the FMU at `path` or the scene file at `path` would have (start,
+/// stop, communication step), with `stop` and `step` as given, read before the run (for an
+/// FMU, from its modelDescription.xml, defaults as `simulate` takes them); `None` for a CSV.
+pub fn planned_experiment(
+    path: &Path,
+    stop: Option<f64>,
+    step: Option<f64>,
+) -> Result<Option<(f64, f64, f64)>, HarnessError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext == "toml" {
+        let ex = Scene::load(path)?.experiment;
+        let (start, stop) = (ex.start_time, stop.unwrap_or(ex.stop_time));
+        return Ok(Some((start, stop, step.unwrap_or(ex.step_size))));
+    }
+    if ext != "fmu" {
+        return Ok(None);
+    }
+    let file = crate::input_file::open(path, "an FMU")?;
+    let Ok(mut zip) = zip::ZipArchive::new(file) else {
+        return Ok(None);
+    };
+    let Ok(entry) = zip.by_name("modelDescription.xml") else {
+        return Ok(None);
+    };
+    let mut xml = String::new();
+    let limit = crate::slave::MAX_EXTRACTED_BYTES;
+    if entry.is_symlink() || entry.take(limit).read_to_string(&mut xml).is_err() {
+        return Ok(None);
+    }
+    // an FMU the master would refuse is refused by the run, with the master's reasons
+    let origin = path.join("modelDescription.xml");
+    let Ok(md) = crate::slave::ModelDescription::parse(&xml, &origin) else {
+        return Ok(None);
+    };
+    let de = md.default_experiment;
+    let start = de.start_time.unwrap_or(0.0);
+    let stop = stop.or(de.stop_time).unwrap_or(start + 1.0);
+    let step = step.or(de.step_size).unwrap_or((stop - start) / 500.0);
+    Ok(Some((start, stop, step)))
+}
+
 /// Runs an FMU with the project's master (its DefaultExperiment unless `stop`/`step` say
-/// otherwise), recording every output; with the scene it carries, if it is one of ours.
+/// otherwise), recording every output; with the scene it carries, if it is one of ours. A run
+/// of more than [`super::MAX_RECORDED_TIMES`] is refused before it starts.
 pub fn run_fmu(
     path: &Path,
     stop: Option<f64>,
     step: Option<f64>,
 ) -> Result<(Recording, Option<Scene>), HarnessError> {
+    if let Some((start, stop, step)) = planned_experiment(path, stop, step)? {
+        super::check_recorded_times(start, stop, step)?;
+    }
     let options = crate::simulate::Options {
         stop_time: stop,
         step,
@@ -117,8 +162,7 @@ pub fn run_fmu(
 
 /// The scene packaged in one of our FMUs (`resources/scene.toml`), `None` for another FMU.
 pub fn packaged_scene(path: &Path) -> Result<Option<Scene>, HarnessError> {
-    let file =
-        std::fs::File::open(path).map_err(|e| HarnessError::io(path, "opening the FMU", e))?;
+    let file = crate::input_file::open(path, "an FMU")?;
     let Ok(mut zip) = zip::ZipArchive::new(file) else {
         return Ok(None);
     };
@@ -175,6 +219,7 @@ pub fn run_scene(
         }
         .into());
     }
+    super::check_recorded_times(start, stop, h)?;
     let mut e = Engine::new(scene.clone());
     e.set_start_time(start).map_err(engine_error)?;
     e.exit_initialization().map_err(engine_error)?;

@@ -295,33 +295,15 @@ fn cosim_cmd(system: &Path, csv: Option<&Path>, out: &mut dyn Write) -> Result<(
 }
 
 /// Runs `run` with a CSV writer on a new temporary sibling of `path` (registered, so that it
-/// goes on an error or a signal), then moves it to `path`.
+/// goes on an error or a signal), then moves it to `path`; a `path` that is not a regular file
+/// or a new name is refused before the run ([`crate::output_file`]).
 fn write_csv_through_temporary<T>(
     path: &Path,
     run: impl FnOnce(&mut dyn simulate::RowSink) -> Result<T, HarnessError>,
 ) -> Result<T, HarnessError> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| HarnessError::BadOutput {
-            path: path.to_path_buf(),
-        })?
-        .to_string_lossy()
-        .into_owned();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let (scratch, file) = crate::scratch::Scratch::file(&tmp)
-        .map_err(|e| HarnessError::io(&tmp, "creating the CSV", e))?;
-    let mut writer = simulate::CsvWriter::new(std::io::BufWriter::new(file));
-    let value = run(&mut writer)?;
-    writer
-        .into_inner()
-        .into_inner()
-        .map_err(|e| e.into_error())
-        .and_then(|f| f.sync_all())
-        .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
-    scratch
-        .persist(path)
-        .map_err(|e| HarnessError::io(path, "moving the CSV in place", e))?;
-    Ok(value)
+    crate::output_file::write_through_temporary(path, "writing the CSV", |file| {
+        run(&mut simulate::CsvWriter::new(file))
+    })
 }
 
 /// The page and the GIF that `animate` writes: `-o` by its extension (.html or .htm a page,
@@ -444,18 +426,9 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
     } = args;
     let (width, height) = parse_size(&size)?;
     let (output, gif) = animation_files(output, gif)?;
-    let started = std::time::Instant::now();
-    let mut scenes: Vec<animate::KnownScene> = scene
-        .iter()
-        .map(|s| animate::known_scene(s))
-        .collect::<Result<_, _>>()?;
-    let (recording, title) = animate_recording(&run, stop, step, &mut scenes)?;
-    let ran = started.elapsed().as_secs_f64();
-    if let Some(path) = &csv {
-        std::fs::write(path, recording.csv())
-            .map_err(|e| HarnessError::io(path, "writing the CSV", e))?;
-    }
-    let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
+    // every file it would write is looked at before the run
+    let outputs = [&output, &gif, &csv, &metadata];
+    crate::output_file::check_all(outputs.iter().filter_map(|p| p.as_deref()))?;
     let options = animate::Options {
         html: output,
         gif,
@@ -466,6 +439,25 @@ fn animate_cmd(args: AnimateArgs, out: &mut dyn Write) -> Result<(), HarnessErro
         width,
         height,
     };
+    // and the work it would do: the options, the recorded times and frames of a run made here
+    animate::check_options(&options)?;
+    let planned = animate::planned_experiment(&run, stop, step)?;
+    // (an experiment that is no interval is refused by the run, saying so)
+    if let Some((start, stop, step)) = planned.filter(|(a, b, h)| b > a && *h > 0.0) {
+        animate::check_recorded_times(start, stop, step)?;
+        animate::check_frames(stop - start, &options)?;
+    }
+    let started = std::time::Instant::now();
+    let mut scenes: Vec<animate::KnownScene> = scene
+        .iter()
+        .map(|s| animate::known_scene(s))
+        .collect::<Result<_, _>>()?;
+    let (recording, title) = animate_recording(&run, stop, step, &mut scenes)?;
+    let ran = started.elapsed().as_secs_f64();
+    if let Some(path) = &csv {
+        crate::output_file::write_atomically(path, recording.csv().as_bytes())?;
+    }
+    let motion = animate::Motion::from_run(&recording, &scenes, &title)?;
     let (m, written) = animate::write(&motion, &options)?;
     writeln!(
         out,
@@ -566,8 +558,7 @@ fn parse_size(s: &str) -> Result<(u32, u32), HarnessError> {
 /// Writes generated text to a file, or to `out`.
 fn write_text(text: &str, path: Option<&Path>, out: &mut dyn Write) -> Result<(), HarnessError> {
     match path {
-        Some(p) => std::fs::write(p, text)
-            .map_err(|e| HarnessError::io(p, "writing the generated file", e)),
+        Some(p) => crate::output_file::write_atomically(p, text.as_bytes()),
         None => out.write_all(text.as_bytes()).map_err(stdout_err),
     }
 }

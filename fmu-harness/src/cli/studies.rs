@@ -89,23 +89,23 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
     o.reference = args.reference.map(|p| (p, args.columns));
     o.progress = true;
     o.recentre = !args.no_recentre;
+    // the files it writes are looked at before the study (the default folder is named after
+    // the scene, known once it is loaded)
+    let named = |dir: &Path| ["accuracy.csv", "accuracy.png", "chosen.toml"].map(|f| dir.join(f));
+    let scene_name =
+        || -> Result<String, HarnessError> { Ok(fmu_beam::Scene::load(&args.scene)?.name) };
+    let dir = match args.dir {
+        Some(d) => d,
+        None => Path::new("build/accuracy").join(scene_name()?),
+    };
+    let [csv, png, chosen] = named(&dir);
+    crate::output_file::check_all([csv.as_path(), &png, &chosen])?;
     let study = accuracy::study(&args.scene, &o)?;
-    let dir = args
-        .dir
-        .unwrap_or_else(|| Path::new("build/accuracy").join(&study.scene));
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| HarnessError::io(&dir, "creating the study's folder", e))?;
-    let csv = dir.join("accuracy.csv");
-    std::fs::write(&csv, accuracy::report::csv(&study))
-        .map_err(|e| HarnessError::io(&csv, "writing the table", e))?;
-    let png = dir.join("accuracy.png");
-    std::fs::write(&png, accuracy::plot::png(&study))
-        .map_err(|e| HarnessError::io(&png, "writing the chart", e))?;
+    crate::output_file::write_atomically(&csv, accuracy::report::csv(&study).as_bytes())?;
+    crate::output_file::write_atomically(&png, &accuracy::plot::png(&study))?;
     let mut wrote = format!("{} and {}", csv.display(), png.display());
     if let Some(c) = &study.choice {
-        let chosen = dir.join("chosen.toml");
-        std::fs::write(&chosen, &c.scene_toml)
-            .map_err(|e| HarnessError::io(&chosen, "writing the chosen scene", e))?;
+        crate::output_file::write_atomically(&chosen, c.scene_toml.as_bytes())?;
         wrote = format!(
             "{}, {wrote} (the scene at the chosen setting)",
             chosen.display()
@@ -131,6 +131,15 @@ pub(super) fn campbell_cmd(
     let speeds = modes::campbell::parse_speeds(spec)?;
     let scene = fmu_beam::Scene::load(scene_path)?;
     let origin = scene_path.display().to_string();
+    let prefix = output.unwrap_or_else(|| PathBuf::from(format!("{}_campbell", scene.name)));
+    let with = |ext: &str| {
+        let mut p = prefix.clone().into_os_string();
+        p.push(ext);
+        PathBuf::from(p)
+    };
+    let (csv, png) = (with(".csv"), with(".png"));
+    // both files are looked at before the first eigenvalue problem
+    crate::output_file::check_all([csv.as_path(), &png])?;
     let mut frequencies = Vec::with_capacity(speeds.len());
     let mut last = None;
     for &speed in &speeds {
@@ -146,16 +155,9 @@ pub(super) fn campbell_cmd(
         speeds,
         frequencies,
     };
-    let prefix = output.unwrap_or_else(|| PathBuf::from(format!("{}_campbell", scene.name)));
-    let with = |ext: &str| {
-        let mut p = prefix.clone().into_os_string();
-        p.push(ext);
-        PathBuf::from(p)
-    };
-    let (csv, png) = (with(".csv"), with(".png"));
-    crate::archive::write_atomically(&csv, d.csv().as_bytes())?;
+    crate::output_file::write_atomically(&csv, d.csv().as_bytes())?;
     let title = format!("{}: Campbell diagram", scene.name);
-    crate::archive::write_atomically(&png, &d.png(&title, 800, 560))?;
+    crate::output_file::write_atomically(&png, &d.png(&title, 800, 560))?;
     let m = last.expect("at least two speeds");
     let text = format!(
         "Campbell diagram of {} modes at {} speeds from {} to {} rad/s (hub '{}'; joints \

@@ -51,6 +51,21 @@ use thiserror::Error;
 pub enum CosimError {
     #[error(transparent)]
     System(#[from] SystemError),
+    /// The units' FMUs would expand to more than a system may (issue 45): refused before any
+    /// is extracted.
+    #[error(
+        "{}: its units' FMUs declare {declared} bytes up to unit `{unit}` ({}); the master \
+         extracts at most {limit} bytes for one system",
+        .path.display(),
+        .fmu.display()
+    )]
+    TooManyBytes {
+        path: PathBuf,
+        unit: String,
+        fmu: PathBuf,
+        declared: u64,
+        limit: u64,
+    },
     #[error("unit `{unit}` ({}): {source}", .fmu.display())]
     Unit {
         unit: String,

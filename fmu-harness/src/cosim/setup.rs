@@ -29,9 +29,33 @@ pub(super) fn load_units(
     rollback: bool,
 ) -> Result<Vec<Unit>, CosimError> {
     let dir = path.parent().unwrap_or(Path::new("."));
+    // what the FMUs declare, all together, before any is extracted; then what each inflates,
+    // counted against what is left
+    let mut declared: u64 = 0;
+    for spec in &system.units {
+        let fmu = dir.join(&spec.fmu);
+        let bytes = crate::slave::declared_bytes(&fmu).map_err(|source| CosimError::Unit {
+            unit: spec.name.clone(),
+            fmu: fmu.clone(),
+            source,
+        })?;
+        declared = declared.saturating_add(bytes);
+        if declared > system::MAX_SYSTEM_EXTRACTED_BYTES {
+            return Err(CosimError::TooManyBytes {
+                path: path.to_path_buf(),
+                unit: spec.name.clone(),
+                fmu,
+                declared,
+                limit: system::MAX_SYSTEM_EXTRACTED_BYTES,
+            });
+        }
+    }
+    let mut left = system::MAX_SYSTEM_EXTRACTED_BYTES;
     let mut units = Vec::with_capacity(system.units.len());
     for spec in &system.units {
-        units.push(load_unit(system, spec, dir, path, rollback)?);
+        let unit = load_unit(system, spec, dir, path, rollback, left)?;
+        left -= unit.slave.extracted_bytes().min(left);
+        units.push(unit);
     }
     Ok(units)
 }
@@ -42,6 +66,7 @@ fn load_unit(
     dir: &Path,
     path: &Path,
     rollback: bool,
+    budget: u64,
 ) -> Result<Unit, CosimError> {
     let fmu = dir.join(&spec.fmu);
     let fail = |source| CosimError::Unit {
@@ -49,7 +74,7 @@ fn load_unit(
         fmu: fmu.clone(),
         source,
     };
-    let mut slave = Slave::load(&fmu).map_err(fail)?;
+    let mut slave = Slave::load_within(&fmu, budget).map_err(fail)?;
     let md = slave.model_description.clone();
     if rollback && !md.can_get_and_set_fmu_state {
         return Err(CosimError::NoFmuState {

@@ -27,6 +27,12 @@ pub enum SystemError {
 
 /// Bytes of a system file: 16 MiB.
 pub const MAX_SYSTEM_FILE_BYTES: u64 = 16 * 1024 * 1024;
+/// Units of one system: 256. Each is an FMU extracted and a library loaded; the shipped
+/// examples couple 2 or 3, co-simulations of a machine a few dozen.
+pub const MAX_UNITS: usize = 256;
+/// Bytes the units' FMUs of one system may expand to, all together: 2 GiB (four FMUs at the
+/// master's limit for one, [`crate::slave::MAX_EXTRACTED_BYTES`]; ours expand to 4 MB).
+pub const MAX_SYSTEM_EXTRACTED_BYTES: u64 = 2 * 1024 * 1024 * 1024;
 
 /// Where the TOML is wrong and why, without the source line toml's own message quotes, and
 /// without the value serde's `invalid type: string "…", expected …` quotes (only its kind is
@@ -421,6 +427,15 @@ impl System {
         }
         if self.units.is_empty() {
             return Err(bad("unit", "at least one [[unit]] is needed".into()));
+        }
+        if self.units.len() > MAX_UNITS {
+            return Err(bad(
+                "unit",
+                format!(
+                    "{} [[unit]] entries: a system has at most {MAX_UNITS}",
+                    self.units.len()
+                ),
+            ));
         }
         for (i, u) in self.units.iter().enumerate() {
             if u.name.is_empty() || u.name.contains('.') {

@@ -5,7 +5,8 @@
 //! and declares at most [`MAX_EXTRACTED_BYTES`] in all. Then the bytes are counted as they are
 //! inflated, since a header can lie: the copy stops one byte past the limit. Files are created
 //! new (`create_new`: an entry given twice is refused) and only in folders this code made, so
-//! nothing it writes can follow a link.
+//! nothing it writes can follow a link. The FMU's path itself must be a regular file, checked
+//! without blocking before it is opened ([`crate::input_file::open`]: a FIFO would block).
 
 use super::{FmuRefused, SlaveError};
 use std::io::Read;
@@ -85,8 +86,43 @@ fn io(path: &Path, action: &'static str) -> impl FnOnce(std::io::Error) -> Slave
     }
 }
 
-/// Extracts `fmu` into `dir` (an empty folder this process made), or refuses it.
-pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
+/// The FMU archive at `fmu`, a regular file (checked without blocking), with at most
+/// [`MAX_ENTRIES`] entries.
+fn open_archive(fmu: &Path) -> Result<zip::ZipArchive<std::fs::File>, SlaveError> {
+    let file = crate::input_file::open(fmu, "an FMU")?;
+    let archive = zip::ZipArchive::new(file).map_err(|source| SlaveError::Zip {
+        path: fmu.to_path_buf(),
+        source,
+    })?;
+    if archive.len() > MAX_ENTRIES {
+        return Err(SlaveError::from(FmuRefused::TooManyEntries {
+            path: fmu.to_path_buf(),
+            entries: archive.len(),
+            limit: MAX_ENTRIES,
+        }));
+    }
+    Ok(archive)
+}
+
+/// The bytes the entries of the FMU at `fmu` declare, all together (from its central
+/// directory; nothing is inflated): what a co-simulation adds up before it extracts a unit.
+pub fn declared_bytes(fmu: &Path) -> Result<u64, SlaveError> {
+    let mut archive = open_archive(fmu)?;
+    let mut declared: u64 = 0;
+    for i in 0..archive.len() {
+        let entry = archive.by_index_raw(i).map_err(|source| SlaveError::Zip {
+            path: fmu.to_path_buf(),
+            source,
+        })?;
+        declared = declared.saturating_add(entry.size());
+    }
+    Ok(declared)
+}
+
+/// Extracts `fmu` into `dir` (an empty folder this process made), or refuses it; at most
+/// `budget` bytes (and never more than [`MAX_EXTRACTED_BYTES`]). Returns the bytes written.
+pub(super) fn extract(fmu: &Path, dir: &Path, budget: u64) -> Result<u64, SlaveError> {
+    let limit = budget.min(MAX_EXTRACTED_BYTES);
     let zip_err = |source| SlaveError::Zip {
         path: fmu.to_path_buf(),
         source,
@@ -104,18 +140,10 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
             entry: shown(name),
             bytes,
             declared,
-            limit: MAX_EXTRACTED_BYTES,
+            limit,
         })
     };
-    let file = std::fs::File::open(fmu).map_err(io(fmu, "opening the FMU"))?;
-    let mut archive = zip::ZipArchive::new(file).map_err(zip_err)?;
-    if archive.len() > MAX_ENTRIES {
-        return Err(SlaveError::from(FmuRefused::TooManyEntries {
-            path: fmu.to_path_buf(),
-            entries: archive.len(),
-            limit: MAX_ENTRIES,
-        }));
-    }
+    let mut archive = open_archive(fmu)?;
     // Every entry's name, kind and declared size first: nothing is written from an FMU that
     // would be refused for any of them.
     let mut plan: Vec<(PathBuf, bool)> = Vec::with_capacity(archive.len());
@@ -126,7 +154,7 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
         let path = relative_path(name).map_err(|r| unsafe_entry(name, r))?;
         let is_dir = kind(entry.unix_mode(), name).map_err(|r| unsafe_entry(name, r))?;
         declared = declared.saturating_add(entry.size());
-        if declared > MAX_EXTRACTED_BYTES {
+        if declared > limit {
             return Err(too_large(name, declared, true));
         }
         plan.push((path, is_dir));
@@ -157,7 +185,7 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
                 io(&target, "creating a file")(source)
             }
         })?;
-        let budget = MAX_EXTRACTED_BYTES - written;
+        let budget = limit - written;
         let copied =
             std::io::copy(&mut (&mut entry).take(budget + 1), &mut out).map_err(|source| {
                 SlaveError::from(FmuRefused::Entry {
@@ -171,7 +199,7 @@ pub(super) fn extract(fmu: &Path, dir: &Path) -> Result<(), SlaveError> {
             return Err(too_large(entry.name(), written, false));
         }
     }
-    Ok(())
+    Ok(written)
 }
 
 /// Where the model's binary must be: a regular file (not a link) inside `dir`.

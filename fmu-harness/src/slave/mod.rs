@@ -9,7 +9,7 @@ mod extract;
 pub use description::{
     Causality, DefaultExperiment, ModelDescription, VarType, Variable, MAX_MODEL_IDENTIFIER_BYTES,
 };
-pub use extract::{MAX_ENTRIES, MAX_EXTRACTED_BYTES, MAX_NAME_BYTES};
+pub use extract::{declared_bytes, MAX_ENTRIES, MAX_EXTRACTED_BYTES, MAX_NAME_BYTES};
 
 use crate::fmi2_binding::{self, Api, FmuState, Instance, LogMessage, Refusal, Status};
 use crate::scratch::Scratch;
@@ -63,6 +63,10 @@ pub enum SlaveError {
     UnknownVariable { name: String },
     #[error("{what} contains a NUL byte")]
     Nul { what: &'static str },
+    /// The FMU's path is not a regular file (a FIFO, a device, a directory): refused without
+    /// being opened for reading, which would block on a FIFO (issue 45).
+    #[error(transparent)]
+    File(#[from] crate::input_file::InputFileError),
 }
 
 /// Why the master refuses an FMU it was given (issue 35): an archive entry, a limit, the model
@@ -199,11 +203,19 @@ pub struct Slave {
     instance: Option<Instance>,
     api: Arc<Api>,
     dir: Scratch,
+    /// Bytes its extraction wrote.
+    extracted: u64,
 }
 
 impl Slave {
     /// Extracts the FMU, reads its model description and loads `binaries/linux64/<id>.so`.
     pub fn load(fmu: &Path) -> Result<Slave, SlaveError> {
+        Slave::load_within(fmu, MAX_EXTRACTED_BYTES)
+    }
+
+    /// [`Slave::load`], extracting at most `budget` bytes (what a co-simulation has left of
+    /// its own budget; never more than [`MAX_EXTRACTED_BYTES`]).
+    pub fn load_within(fmu: &Path, budget: u64) -> Result<Slave, SlaveError> {
         let stem = fmu
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -219,17 +231,27 @@ impl Slave {
             source,
         })?;
         // On an error `dir` is dropped here, which removes it.
-        let (model_description, api) = Self::load_into(fmu, dir.path())?;
+        let (model_description, api, extracted) = Self::load_into(fmu, dir.path(), budget)?;
         Ok(Slave {
             model_description,
             instance: None,
             api,
             dir,
+            extracted,
         })
     }
 
-    fn load_into(fmu: &Path, dir: &Path) -> Result<(ModelDescription, Arc<Api>), SlaveError> {
-        extract::extract(fmu, dir)?;
+    /// The bytes its extraction wrote.
+    pub fn extracted_bytes(&self) -> u64 {
+        self.extracted
+    }
+
+    fn load_into(
+        fmu: &Path,
+        dir: &Path,
+        budget: u64,
+    ) -> Result<(ModelDescription, Arc<Api>, u64), SlaveError> {
+        let extracted = extract::extract(fmu, dir, budget)?;
         let md_path = dir.join("modelDescription.xml");
         let xml = std::fs::read_to_string(&md_path).map_err(|source| SlaveError::Io {
             path: fmu.join("modelDescription.xml"),
@@ -244,7 +266,7 @@ impl Slave {
         extract::binary_inside(dir, &so)?;
         extract::binary_loadable(&so, PLATFORM)?;
         let api = Api::load(&so)?;
-        Ok((md, api))
+        Ok((md, api, extracted))
     }
 
     /// The directory the FMU was extracted to (removed on drop).
