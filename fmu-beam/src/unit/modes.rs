@@ -148,11 +148,11 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
     }
     crate::unit::memory::ensure_available(&scene, "natural frequencies")?;
     let undamped = linear_model(&scene, options)?;
-    let solved = eigen::solve(&undamped.lin, spinning)?;
+    let solved = eigen::solve(&undamped.lin, spinning, false)?;
     let placed_acceleration = undamped.start.qdd.amax();
     let (at, solved_damped) = if has_damping {
         let lin = linear_model(&damped_scene, options)?;
-        let s = eigen::solve(&lin.lin, true)?;
+        let s = eigen::solve(&lin.lin, true, true)?;
         (lin, Some(s))
     } else {
         (undamped, None)

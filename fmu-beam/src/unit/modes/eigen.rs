@@ -53,8 +53,10 @@ fn inverse_factor(m: &DMatrix<f64>, what: &str) -> Result<DMatrix<f64>, EngineEr
 }
 
 /// Eigen-solves `lin`: by the state space when `state_space` (gyroscopic or damped), else the
-/// symmetric problem without C.
-pub fn solve(lin: &Linear, state_space: bool) -> Result<Solved, EngineError> {
+/// symmetric problem without C. Without `damping` (C only gyroscopic, the eigenvalues
+/// imaginary) a mode's ratio is 0 and its natural frequency |Im s|/2π, not the rounding of
+/// Re s.
+pub fn solve(lin: &Linear, state_space: bool, damping: bool) -> Result<Solved, EngineError> {
     let r = lin.m.nrows();
     if r == 0 {
         return Ok(Solved::default());
@@ -146,10 +148,15 @@ pub fn solve(lin: &Linear, state_space: bool) -> Result<Solved, EngineError> {
             let v = vectors.column(j);
             let re = DVector::from_fn(s, |i, _| v[i].re);
             let im = DVector::from_fn(s, |i, _| v[i].im);
+            let (natural, ratio) = if damping {
+                (z.norm() / TAU, -z.re / z.norm())
+            } else {
+                (z.im / TAU, 0.0)
+            };
             out.modes.push(RawMode {
-                natural: z.norm() / TAU,
+                natural,
                 damped: z.im / TAU,
-                ratio: -z.re / z.norm(),
+                ratio,
                 shape: (&w * re, &w * im),
             });
         }
