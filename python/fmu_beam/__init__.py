@@ -23,8 +23,10 @@ from typing import Any, Dict, List, Optional
 
 from fmu_beam._native import Error, Packaged, Scene, SceneError, __version__
 from fmu_beam import _native
+from fmu_beam._modes import Modes
 
 __all__ = ["Error", "Packaged", "Scene", "SceneError", "__version__", "engines", "main", "reference", "schema"]
+__all__ += ["Modes"]
 
 
 def schema() -> Dict[str, Any]:
