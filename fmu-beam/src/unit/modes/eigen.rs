@@ -179,10 +179,11 @@ fn oscillates(z: Complex<f64>, size: f64) -> bool {
     z.im.abs() > (f64::EPSILON * size * z.norm()).sqrt()
 }
 
+/// Eigenvalues and eigenvectors (columns).
+type Eigen = (Vec<Complex<f64>>, DMatrix<Complex<f64>>);
+
 /// Eigenvalues and eigenvectors (columns) of a real square matrix, by faer's Schur form.
-fn state_space_eigen(
-    a: &DMatrix<f64>,
-) -> Result<(Vec<Complex<f64>>, DMatrix<Complex<f64>>), EngineError> {
+fn state_space_eigen(a: &DMatrix<f64>) -> Result<Eigen, EngineError> {
     let n = a.nrows();
     let m = faer::Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)]);
     let evd = m.eigen().map_err(|e| EngineError::Modes {
