@@ -296,9 +296,8 @@ fn cantilever_mode_shapes_are_beam_theory() {
         for i in 1..=17 {
             let x = L * (i - 1) as f64 / 16.0;
             worst = worst.max((at(&format!("beam.shape.y[{i}]")) / tip - phi(x) / phi(L)).abs());
-            worst = worst.max(
-                (at(&format!("beam.shape.phi[{i}]")) / tip - slope(x) / phi(L)).abs() * L,
-            );
+            worst = worst
+                .max((at(&format!("beam.shape.phi[{i}]")) / tip - slope(x) / phi(L)).abs() * L);
             along = along.max(at(&format!("beam.shape.x[{i}]")).abs());
         }
         println!(
