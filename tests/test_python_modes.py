@@ -5,6 +5,7 @@ two threads; numpy and pandas imported only when asked for."""
 
 import json
 import math
+import pickle
 import subprocess
 import sys
 from pathlib import Path
@@ -48,6 +49,11 @@ def test_modes_is_still_the_list_of_frequencies():
     assert all(type(f) is float for f in m) and m[0] == m.frequencies[0]
     assert pendulum.modes(count=5)[:2] == m
     assert len(pendulum.modes()) > 5
+    # a result travels (to a Dask worker and back) with its arrays
+    back = pickle.loads(pickle.dumps(m))
+    assert back == m and np.array_equal(back.shapes, m.shapes) and back.coordinates == m.coordinates
+    none = pendulum.modes(count=0)
+    assert none == [] and none.shapes.shape == (len(m.coordinates), 0)
 
 
 def test_import_needs_neither_numpy_nor_pandas():
