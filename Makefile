@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice example-split example-hinge example-arm example-sweep clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -275,6 +275,12 @@ bench-choice: release
 	  done; \
 	done
 
+# What the Python studies cost (issue 44): Scene.simulate against fmpy, a 32-variant sweep on 1
+# and 2 local processes and Dask workers, what a task ships (bench/studies.py, about 8 min);
+# build/bench/STUDIES.md.
+bench-studies: wheel fmus
+	$(PY) bench/studies.py
+
 # The split slider-crank (examples/split_slider_crank): the explicit couplings (cosim, the fmpy
 # script, the step study), then the joint at the pin (cosim, the fmpy script, the joint study).
 example-split: .venv fmus
@@ -300,6 +306,11 @@ example-arm: .venv fmus
 
 example-sweep: .venv fmus
 	$(PY) examples/sweep.py
+
+# The worked study of docs/python.md: the blade's droop over speed and modulus (fmu_beam.sweep on
+# every core; the wheel installed in .venv, as `make wheel` leaves it).
+example-droop: wheel
+	$(PY) examples/blade_droop/droop_sweep.py
 
 clean:
 	rm -rf build dist $(WHEEL_ENGINES) .pytest_cache tests/__pycache__

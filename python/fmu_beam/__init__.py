@@ -21,11 +21,25 @@ import sys
 from pathlib import Path
 from typing import Any, Dict, List, Optional
 
-from fmu_beam._native import Error, Packaged, Scene, SceneError, __version__
+from fmu_beam._native import Error, Packaged, Scene, SceneError, SimulationError, Unit, __version__
 from fmu_beam import _native
+from fmu_beam._sweep import sweep
 from fmu_beam._modes import Modes
 
-__all__ = ["Error", "Packaged", "Scene", "SceneError", "__version__", "engines", "main", "reference", "schema"]
+__all__ = [
+    "Error",
+    "Packaged",
+    "Scene",
+    "SceneError",
+    "SimulationError",
+    "Unit",
+    "__version__",
+    "engines",
+    "main",
+    "reference",
+    "schema",
+    "sweep",
+]
 __all__ += ["Modes"]
 
 

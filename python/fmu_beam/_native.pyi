@@ -2,7 +2,7 @@
 ``fmu_beam``, which re-exports these."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 __version__: str
 
@@ -27,6 +27,21 @@ class SceneError(Error):
     """What the value breaks ('must be positive'), or the parser's message."""
     code: Optional[str]
     """The rule's code in the scene reference, or None."""
+
+class SimulationError(Error):
+    """A run that the unit could not continue: a step it refused (fmi2Discard) or a failure."""
+
+    time: float
+    """The last good time (s): the state stays there."""
+    reason: str
+    """The unit's message."""
+    ended: bool
+    """True where no smaller step can pass (the model left its range)."""
+    discard: bool
+    """True for a step the unit discarded (a smaller one may pass unless ``ended``)."""
+    rows: Any
+    """From :meth:`Scene.simulate`: a pandas DataFrame of every communication point up to
+    ``time``."""
 
 class Packaged:
     """What :meth:`Scene.package` wrote."""
@@ -126,7 +141,65 @@ class Scene:
         """Writes the scene's FMU to ``path`` with this package's engines of ``platforms``
         ('linux64', 'win64'; default: all it carries), or with the engine libraries of
         ``binaries`` ({'linux64': path, ...}, like ``--binary``)."""
+    def simulate(
+        self,
+        stop_time: Optional[float] = None,
+        step_size: Optional[float] = None,
+        outputs: Optional[Sequence[str]] = None,
+        start_values: Optional[Mapping[str, Any]] = None,
+        inputs: Union[None, Any, Callable[[float, Dict[str, float]], Mapping[str, float]]] = None,
+        interpolation: str = "linear",
+        start_time: Optional[float] = None,
+    ) -> Any:
+        """Runs the scene in process with its unit's engine (as fmpy runs the packaged FMU, bit
+        for bit) and returns a pandas DataFrame indexed by time, one column per output (default:
+        every output; units in ``df.attrs["units"]``). ``start_values``: parameters;
+        ``inputs``: time series (a DataFrame indexed by time, or a dict of arrays with 'time')
+        followed linearly (``interpolation="linear"``, through the input derivatives) or held
+        (``"hold"``), or a callable ``(t, outputs) -> {input: value}`` called at every
+        communication point. A step the unit cannot take raises :class:`SimulationError`."""
     def __eq__(self, other: object) -> bool: ...
+    def __reduce__(self) -> Any: ...
+
+class Unit:
+    """One instance of a scene's unit in process, driven with the calls of an FMI 2.0 master
+    (what :meth:`Scene.simulate` drives; for loops of your own). Variables by value reference
+    (:meth:`references`)."""
+
+    def __init__(self, scene: Scene) -> None: ...
+    def variables(self) -> List[Tuple[str, str, str, str, Optional[str]]]:
+        """(name, type, causality, variability, unit) of every variable, by value reference."""
+    def references(self, names: Sequence[str]) -> List[Tuple[int, str]]:
+        """(value reference, type) of each name."""
+    def output_names(self) -> List[str]:
+        """The outputs' names."""
+    def setup(self, start_time: float, tolerance: Optional[float] = None) -> None:
+        """fmi2SetupExperiment."""
+    def set_real(self, vrs: Sequence[int], values: Sequence[float]) -> None:
+        """fmi2SetReal, all or nothing."""
+    def set_integer(self, vrs: Sequence[int], values: Sequence[int]) -> None:
+        """fmi2SetInteger, all or nothing."""
+    def set_boolean(self, vrs: Sequence[int], values: Sequence[bool]) -> None:
+        """fmi2SetBoolean, all or nothing."""
+    def set_input_derivatives(self, vrs: Sequence[int], values: Sequence[float]) -> None:
+        """fmi2SetRealInputDerivatives of order 1."""
+    def exit_initialization(self) -> None:
+        """fmi2ExitInitializationMode (builds the model)."""
+    def do_step(self, t: float, h: float) -> None:
+        """fmi2DoStep; raises :class:`SimulationError` for a step the unit cannot take."""
+    def get_real(self, vrs: Sequence[int]) -> List[float]:
+        """fmi2GetReal."""
+    def get_integer(self, vrs: Sequence[int]) -> List[int]:
+        """fmi2GetInteger."""
+    def get_boolean(self, vrs: Sequence[int]) -> List[bool]:
+        """fmi2GetBoolean."""
+    @property
+    def time(self) -> float:
+        """The last accepted communication point (s)."""
+    def messages(self) -> List[str]:
+        """The warnings logged since the last call."""
+    def units(self, names: Sequence[str]) -> Dict[str, Optional[str]]:
+        """The unit of each name (None: dimensionless)."""
 
 def schema_text() -> str:
     """The JSON Schema of scene files, as text."""

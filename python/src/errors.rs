@@ -26,6 +26,16 @@ pyo3::create_exception!(
      scene reference, or None)."
 );
 
+pyo3::create_exception!(
+    fmu_beam,
+    SimulationError,
+    Error,
+    "A run that the unit could not continue: a step it refused (fmi2Discard) or a failure. \
+     Attributes: `time` (the last good time, s), `reason` (the unit's message), `ended` (True \
+     where no smaller step can pass: the model left its range), and, from Scene.simulate, \
+     `rows` (a DataFrame of every communication point up to `time`)."
+);
+
 /// The parts of a refusal, as [`SceneError`]'s attributes.
 #[derive(Debug, Default)]
 pub struct Refusal {

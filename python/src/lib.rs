@@ -11,6 +11,7 @@ mod engines;
 mod errors;
 mod modes;
 mod scene;
+mod unit;
 
 use clap::{CommandFactory, FromArgMatches};
 use fmu_harness::cli::Cli;
@@ -107,8 +108,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("Error", py.get_type::<errors::Error>())?;
     m.add("SceneError", py.get_type::<errors::SceneError>())?;
+    m.add("SimulationError", py.get_type::<errors::SimulationError>())?;
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::Packaged>()?;
+    m.add_class::<unit::PyUnit>()?;
     m.add_function(wrap_pyfunction!(schema_text, m)?)?;
     m.add_function(wrap_pyfunction!(reference_text, m)?)?;
     m.add_function(wrap_pyfunction!(carried_engines, m)?)?;

@@ -9,7 +9,7 @@ use fmu_harness::package::{self, BinaryArg};
 use fmu_harness::platform::Platform;
 use fmu_harness::HarnessError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -28,6 +28,13 @@ fn detached<T: Send>(
 ) -> PyResult<T> {
     py.detach(|| guard(|| Ok(f())))?
         .map_err(|e| harness_err(py, e))
+}
+
+impl PyScene {
+    /// The validated scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
 }
 
 #[pymethods]
@@ -124,6 +131,28 @@ impl PyScene {
                 .map_err(|e| crate::errors::Error::new_err(e.to_string()))?;
             convert::table_to_python(py, &table)
         })
+    }
+
+    /// Runs the scene in process with the unit's own engine and returns a pandas DataFrame
+    /// indexed by time (see `fmu_beam._simulate.simulate`, which this hands over to).
+    #[pyo3(signature = (*args, **kwargs))]
+    fn simulate<'py>(
+        slf: &Bound<'py, Self>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let run = py.import("fmu_beam._simulate")?.getattr("simulate")?;
+        let mut all = vec![slf.clone().into_any()];
+        all.extend(args.iter());
+        run.call(PyTuple::new(py, all)?, kwargs)
+    }
+
+    /// Pickles as its canonical text (a few kB: what a sweep's task ships to a worker).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String, String))> {
+        let me = slf.get();
+        let from_toml = slf.get_type().getattr("from_toml")?;
+        Ok((from_toml, (me.scene.to_toml_string(), me.origin.clone())))
     }
 
     /// The accuracy the scene was tuned for (its `[accuracy]`, if any), then the effects the
