@@ -38,7 +38,7 @@ pub use unit::effects::{resolve as resolve_effects, Decision, Resolution, EFFECT
 pub use unit::engine::Engine;
 pub use unit::interface::explain as explain_feedthrough;
 pub use unit::interface::explain_accuracy;
-pub use unit::modes::{modes, natural_frequencies, DampedMode, ModeOptions, Modes};
+pub use unit::modes::{modes, natural_frequencies, Mode, ModeOptions, Modes};
 pub use unit::variables::{
     Binding, Causality, Initial, UnitDef, VarType, Variability, Variable, VariableTable, UNITS,
 };

@@ -55,6 +55,11 @@ pub fn full_report(m: &Modes, count: usize) -> String {
             significant(a, 3)
         );
     }
+    if m.runs_planar {
+        s += "the scene runs with the planar element (its motion stays in the x-y plane); \
+              these are its 3D structure's modes, with the spatial element: the out-of-plane \
+              ones included\n";
+    }
     if m.locked.is_empty() {
         s += "joints locked: none\n";
     } else {
@@ -71,13 +76,15 @@ pub fn full_report(m: &Modes, count: usize) -> String {
         );
     }
     s += &report(&m.frequencies, count);
-    for (k, d) in m.damped.iter().take(count).enumerate() {
-        s += &format!(
-            "damped mode {}: {} Hz, damping ratio {}\n",
-            k + 1,
-            significant(d.frequency, 9),
-            significant(d.damping_ratio, 4)
-        );
+    if m.damped {
+        for (k, d) in m.modes.iter().take(count).enumerate() {
+            s += &format!(
+                "damped mode {}: {} Hz, damping ratio {}\n",
+                k + 1,
+                significant(d.damped_frequency, 9),
+                significant(d.damping_ratio, 4)
+            );
+        }
     }
     s
 }

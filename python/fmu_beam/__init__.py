@@ -24,6 +24,7 @@ from typing import Any, Dict, List, Optional
 from fmu_beam._native import Error, Packaged, Scene, SceneError, SimulationError, Unit, __version__
 from fmu_beam import _native
 from fmu_beam._sweep import sweep
+from fmu_beam._modes import Modes
 
 __all__ = [
     "Error",
@@ -39,6 +40,7 @@ __all__ = [
     "schema",
     "sweep",
 ]
+__all__ += ["Modes"]
 
 
 def schema() -> Dict[str, Any]:

@@ -6,6 +6,8 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 __version__: str
 
+from fmu_beam._modes import Modes
+
 StrPath = Union[str, "os.PathLike[str]"]
 
 class Error(Exception):
@@ -105,9 +107,35 @@ class Scene:
     def explain(self) -> str:
         """The accuracy the scene was tuned for (its ``[accuracy]``, if any), then the effects
         the unit simulates, why, and their estimated share of the cost."""
-    def modes(self, count: Optional[int] = None) -> List[float]:
-        """The linearized elastic natural frequencies in Hz, ascending (rigid-body modes left
-        out), at most ``count`` of them."""
+    # --- modes (python/src/modes.rs, python/fmu_beam/_modes.py) ---
+    def modes(
+        self,
+        count: Optional[int] = None,
+        speed: Optional[float] = None,
+        lock: Union[None, bool, str, Sequence[str]] = None,
+        equilibrium: bool = False,
+        hub: Optional[str] = None,
+    ) -> "Modes":
+        """The linearized modes, at most ``count`` (all when None): a list of their natural
+        frequencies in Hz (rigid-body and non-oscillating modes left out) with numpy arrays of
+        damping ratios and shapes on named coordinates. At rest, or about the steady state
+        spinning at ``speed`` rad/s about ``hub`` (default: the revolute joint to world with a
+        motion drive); ``lock``: a joint's name, a list, or True for every joint;
+        ``equilibrium``: at rest about the static equilibrium under gravity and the loads. A 3D
+        scene's modes are the 3D structure's (spatial element), out-of-plane ones included."""
+    def campbell(
+        self,
+        speeds: Sequence[float],
+        count: Optional[int] = None,
+        lock: Union[None, bool, str, Sequence[str]] = None,
+        hub: Optional[str] = None,
+        jobs: Optional[int] = None,
+    ) -> Any:
+        """The Campbell diagram: a pandas DataFrame indexed by ``speed`` (rad/s), one column per
+        mode (``mode1`` ... in Hz: the natural frequencies of :meth:`modes` at each speed), then
+        ``damping_ratio1`` ... where a beam has damping; units in ``df.attrs["units"]``. The
+        speeds run on ``jobs`` threads (default: every core), with the serial run's numbers."""
+    # --- end of modes ---
     def variables(self) -> List[Dict[str, Any]]:
         """The unit's variables in value-reference order: name, value_reference, causality,
         variability, type, unit, start, description."""

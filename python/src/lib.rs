@@ -9,6 +9,7 @@
 mod convert;
 mod engines;
 mod errors;
+mod modes;
 mod scene;
 mod unit;
 

@@ -173,18 +173,44 @@ impl PyScene {
         detached(py, || fmu_harness::package::explain(&self.scene))
     }
 
-    /// The linearized elastic natural frequencies in Hz, ascending (rigid-body modes left
-    /// out), at most `count` of them (all when None), as `fmu-beam modes` prints them.
-    #[pyo3(signature = (count = None))]
-    fn modes(&self, py: Python<'_>, count: Option<usize>) -> PyResult<Vec<f64>> {
-        let mut f = detached(py, || {
-            fmu_harness::modes::elastic_frequencies_of(&self.scene, &self.origin)
-        })?;
-        if let Some(n) = count {
-            f.truncate(n);
-        }
-        Ok(f)
+    // --- modes (python/src/modes.rs, python/fmu_beam/_modes.py) ---
+
+    /// The linearized modes (fmu_beam.Modes: a list of the natural frequencies in Hz, with
+    /// their damping ratios and shapes as numpy arrays), at most `count` (all when None): at
+    /// rest, or about the steady state spinning at `speed` rad/s about the `hub`; joints
+    /// `lock`ed (a name, a list, or True for all); at rest about the static `equilibrium`.
+    #[pyo3(signature = (count = None, speed = None, lock = None, equilibrium = false, hub = None))]
+    fn modes<'py>(
+        &self,
+        py: Python<'py>,
+        count: Option<usize>,
+        speed: Option<f64>,
+        lock: Option<&Bound<'py, PyAny>>,
+        equilibrium: bool,
+        hub: Option<String>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = crate::modes::options(lock, speed, hub, equilibrium)?;
+        crate::modes::modes(py, &self.scene, &self.origin, count, o)
     }
+
+    /// The Campbell diagram: the first `count` modes at each of `speeds` (rad/s) as a pandas
+    /// DataFrame indexed by speed, one column per mode (Hz), on `jobs` threads (all cores when
+    /// None).
+    #[pyo3(signature = (speeds, count = None, lock = None, hub = None, jobs = None))]
+    fn campbell<'py>(
+        &self,
+        py: Python<'py>,
+        speeds: Vec<f64>,
+        count: Option<usize>,
+        lock: Option<&Bound<'py, PyAny>>,
+        hub: Option<String>,
+        jobs: Option<usize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = crate::modes::options(lock, None, hub, false)?;
+        crate::modes::campbell(py, &self.scene, &self.origin, speeds, count, o, jobs)
+    }
+
+    // --- end of modes ---
 
     /// The unit's variables, in value-reference order, as dicts: name, value_reference,
     /// causality, variability, type, unit (None if dimensionless), start (parameters), and

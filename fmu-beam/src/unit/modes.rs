@@ -14,12 +14,16 @@
 
 mod eigen;
 mod linearize;
+mod shapes;
 
 use crate::error::EngineError;
 use crate::integrator::{initial_state, Settings};
+use crate::mechanics::multibody::equations::Equations;
 use crate::mechanics::Mechanics;
-use crate::scene::{DriveKind, DriveSpec, JointKind, LawSpec, Scene};
+use crate::scene::{DriveKind, DriveSpec, Formulation, JointKind, LawSpec, Scene};
+use crate::unit::effects::Effects;
 use crate::unit::engine::Engine;
+use nalgebra::DVector;
 
 /// How to linearize: which joints to lock, and at what hub speed.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -38,13 +42,20 @@ pub struct ModeOptions {
     pub equilibrium: bool,
 }
 
-/// One oscillating mode of the damped system.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DampedMode {
-    /// Damped natural frequency |Im s| / 2π (Hz).
+/// One oscillating mode: its frequencies, damping ratio and shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// Natural frequency |s|/2π (Hz): without damping, the undamped frequency; with Rayleigh
+    /// damping proportional to the mode, the same.
     pub frequency: f64,
-    /// Damping ratio -Re s / |s|.
+    /// Damped natural frequency |Im s|/2π = `frequency` √(1 − ζ²) (Hz).
+    pub damped_frequency: f64,
+    /// Damping ratio ζ = −Re s/|s| (0 without damping).
     pub damping_ratio: f64,
+    /// The shape on [`Modes::coordinates`], its largest component 1: the real part of the
+    /// eigenvector turned by the phase that makes it as real as possible (exactly real
+    /// without damping or spin).
+    pub shape: Vec<f64>,
 }
 
 /// The modes of a linearized scene.
@@ -53,13 +64,21 @@ pub struct Modes {
     /// Natural frequencies without the scene's damping (Hz, ascending): gyroscopic terms
     /// kept at speed; rigid-body modes left out.
     pub frequencies: Vec<f64>,
-    /// With the scene's Rayleigh damping, where a beam has some (else empty): one per
-    /// oscillating mode, by ascending frequency.
-    pub damped: Vec<DampedMode>,
+    /// The oscillating modes by ascending natural frequency: the damped system's where a beam
+    /// has Rayleigh damping ([`Modes::damped`]), else the undamped ones (one per entry of
+    /// `frequencies`).
+    pub modes: Vec<Mode>,
+    /// Whether a beam has Rayleigh damping (then `modes` are the damped system's).
+    pub damped: bool,
+    /// The names of a shape's entries: each beam's shape points (`<beam>.shape.x[i]`, `.y[i]`,
+    /// `.z[i]`, the unit's shape outputs, i from 1 at flange a; then the section's rotation
+    /// `.phi[i]` planar, `.rx[i]`, `.ry[i]`, `.rz[i]` 3D, world axes), then each rigid body's
+    /// origin (`<body>.x`, …).
+    pub coordinates: Vec<String>,
     /// How many motions have no stiffness at all (rigid-body modes).
     pub rigid_body_modes: usize,
-    /// Modes that do not oscillate (real eigenvalue pairs: overdamped, or diverging when
-    /// centrifugal softening exceeds the stiffness).
+    /// Modes that do not oscillate: real eigenvalue pairs (overdamped, or diverging when
+    /// centrifugal softening exceeds the stiffness), of the damped system where it is damped.
     pub non_oscillating: usize,
     /// The joints held fixed (named, or all with `lock_all`), in scene order.
     pub locked: Vec<String>,
@@ -76,12 +95,16 @@ pub struct Modes {
     /// then the placement is no equilibrium, and `equilibrium` linearizes about the deformed
     /// state instead.
     pub off_equilibrium: Option<f64>,
+    /// A 3D scene that runs with the planar element (its motion stays in the x–y plane,
+    /// [`Scene::planar_reduction`]): its modes are still the 3D structure's, linearized with
+    /// the spatial element, so that the out-of-plane ones are there.
+    pub runs_planar: bool,
 }
 
 /// Natural frequencies (Hz), ascending, of the scene linearized about its initial
 /// configuration at rest with its joints free: one 0 for each rigid-body mode, then the
-/// elastic ones. A 3D scene is linearized with the element it runs with (planar when its
-/// motion is planar).
+/// elastic ones. A 3D scene is linearized with the spatial element (out-of-plane modes
+/// included), even where its motion is planar and runs with the planar one.
 pub fn natural_frequencies(scene: &Scene) -> Result<Vec<f64>, EngineError> {
     let m = modes(scene, &ModeOptions::default())?;
     let mut f = vec![0.0; m.rigid_body_modes];
@@ -113,6 +136,7 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
     for b in &mut scene.beams {
         b.initial.tip_displacement = 0.0;
     }
+    let runs_planar = spatial_structure(&mut scene)?;
     let damped_scene = scene.clone();
     let has_damping = scene
         .beams
@@ -123,19 +147,28 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         b.rayleigh.beta = 0.0;
     }
     crate::unit::memory::ensure_available(&scene, "natural frequencies")?;
-    let (undamped, placed_acceleration) = linear_model(&scene, options)?;
-    let solved = eigen::solve(&undamped, spinning)?;
-    let damped = if has_damping {
-        let (lin, _) = linear_model(&damped_scene, options)?;
-        eigen::solve(&lin, true)?.damped
+    let undamped = linear_model(&scene, options)?;
+    let solved = eigen::solve(&undamped.lin, spinning, false)?;
+    let placed_acceleration = undamped.start.qdd.amax();
+    let (at, solved_damped) = if has_damping {
+        let lin = linear_model(&damped_scene, options)?;
+        let s = eigen::solve(&lin.lin, true, true)?;
+        (lin, Some(s))
     } else {
-        Vec::new()
+        (undamped, None)
     };
+    let (listed, non_oscillating) = match &solved_damped {
+        Some(s) => (&s.modes, s.non_oscillating),
+        None => (&solved.modes, solved.non_oscillating),
+    };
+    let (coordinates, modes) = at.shapes(&damped_scene, listed);
     Ok(Modes {
         frequencies: solved.frequencies,
-        damped,
+        modes,
+        damped: has_damping,
+        coordinates,
         rigid_body_modes: solved.rigid,
-        non_oscillating: solved.non_oscillating,
+        non_oscillating,
         locked: to_lock,
         driven: given
             .joints
@@ -152,60 +185,185 @@ pub fn modes(scene: &Scene, options: &ModeOptions) -> Result<Modes, EngineError>
         equilibrium: options.equilibrium && !spinning,
         off_equilibrium: (!spinning && !options.equilibrium && placed_acceleration > 1e-6)
             .then_some(placed_acceleration),
+        runs_planar,
     })
 }
 
-/// The scene's system linearized at rest (its start, or its static equilibrium) or at the
-/// steady state at the options' speed; and the largest acceleration of the consistent start.
-fn linear_model(
-    scene: &Scene,
-    options: &ModeOptions,
-) -> Result<(linearize::Linear, f64), EngineError> {
-    let (lin, st) = linear_model_at(scene, options)?;
-    Ok((lin, st.qdd.amax()))
+/// A 3D scene is linearized with the spatial element: the planar reduction is exact for its
+/// motion, which stays in the x–y plane, but a mode is any small motion about it, out of the
+/// plane too (a blade's flap modes). Returns whether the scene runs with the planar element.
+fn spatial_structure(scene: &mut Scene) -> Result<bool, EngineError> {
+    if !scene.is_3d() || scene.planar_reduction().is_err() {
+        return Ok(false);
+    }
+    scene.formulation = Formulation::Spatial;
+    scene.validate("modes").map_err(|e| {
+        modes_error(format!(
+            "the scene runs with the planar element; its 3D modes need the spatial one, which \
+             it cannot use: {e}"
+        ))
+    })?;
+    Ok(true)
 }
 
-/// [`linear_model`], with the consistent start it began from.
-fn linear_model_at(
-    scene: &Scene,
-    options: &ModeOptions,
-) -> Result<(linearize::Linear, crate::integrator::GaState), EngineError> {
+/// A scene's system, linearized: the linearization, the system and where it was taken, and
+/// the consistent start it began from.
+struct Linearized {
+    lin: linearize::Linear,
+    sys: Mechanics,
+    q: DVector<f64>,
+    effects: Effects,
+    start: crate::integrator::GaState,
+}
+
+impl Linearized {
+    /// The coordinates' names and the modes with their shapes on them.
+    fn shapes(&self, scene: &Scene, modes: &[eigen::RawMode]) -> (Vec<String>, Vec<Mode>) {
+        let points = shapes::Coordinates::new(scene, &self.effects, &self.sys);
+        let scale = self.sys.length_scale().max(1e-3);
+        let out = modes
+            .iter()
+            .map(|m| {
+                let re = points.map(&self.sys, &self.q, &(&self.lin.basis * &m.shape.0), scale);
+                let im = points.map(&self.sys, &self.q, &(&self.lin.basis * &m.shape.1), scale);
+                Mode {
+                    frequency: m.natural,
+                    damped_frequency: m.damped,
+                    damping_ratio: m.ratio,
+                    shape: most_real(&re, &im),
+                }
+            })
+            .collect();
+        (points.names, out)
+    }
+}
+
+/// Re(e^{iφ} (a + ib)) with the phase φ that makes it longest (as real as possible),
+/// scaled so that its largest component is 1: φ = −½ arg Σ (a_k + i b_k)².
+fn most_real(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let (mut re, mut im) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        re += x * x - y * y;
+        im += 2.0 * x * y;
+    }
+    let phi = -0.5 * im.atan2(re);
+    let (s, c) = phi.sin_cos();
+    let v: Vec<f64> = a.iter().zip(b).map(|(x, y)| x * c - y * s).collect();
+    let big = v
+        .iter()
+        .copied()
+        .fold(0.0f64, |m, x| if x.abs() > m.abs() { x } else { m });
+    if big == 0.0 {
+        return v;
+    }
+    v.into_iter().map(|x| x / big).collect()
+}
+
+/// The scene's system linearized at rest (its start, or its static equilibrium) or at the
+/// steady state at the options' speed.
+fn linear_model(scene: &Scene, options: &ModeOptions) -> Result<Linearized, EngineError> {
     let speed = options.speed;
     let settings = Settings::from_scene(scene);
     let effects = crate::unit::effects::resolve(scene).effects;
     let sys = Mechanics::build(scene, &effects);
     let st = initial_state(&sys, 0.0, &settings)?;
     let spin = linearize::Spin::of(&sys);
-    if speed == 0.0 {
-        let lin = if options.equilibrium {
-            let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, 0.0)?;
-            linearize::corotating(&sys, &spin, &q, &lambda, 0.0)?
+    let (q, lambda) = if speed == 0.0 {
+        if options.equilibrium {
+            linearize::steady_state(&sys, &spin, &st.q, &st.lambda, &linearize::ramp(0.0))?
         } else {
-            linearize::corotating(&sys, &spin, &st.q, &st.lambda, 0.0)?
-        };
-        return Ok((lin, st));
+            (st.q.clone(), st.lambda.clone())
+        }
+    } else {
+        steady_at_speed(&sys)?;
+        spinning(&sys, &spin, &st, speed)?
+    };
+    let lin = linearize::corotating(&sys, &spin, &q, &lambda, speed)?;
+    Ok(Linearized {
+        lin,
+        sys,
+        q,
+        effects,
+        start: st,
+    })
+}
+
+/// The steady state spinning at `speed`, reached in 8 steps of speed from rest; under gravity
+/// (along the hub's axis) first without it, which then comes in 8 steps at full speed: a
+/// hinged part has no steady state under gravity at low speeds (it hangs).
+fn spinning(
+    sys: &Mechanics,
+    spin: &linearize::Spin,
+    start: &crate::integrator::GaState,
+    speed: f64,
+) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
+    let with_gravity = |share: f64| {
+        let mut s = sys.clone();
+        if let Mechanics::Spatial(s, _) = &mut s {
+            s.gravity = s.gravity.map(|g| g * share);
+        }
+        s
+    };
+    let weighs =
+        matches!(sys, Mechanics::Spatial(s, _) if s.gravity.is_some_and(|g| g.norm() > 0.0));
+    if !weighs {
+        return linearize::steady_state(
+            sys,
+            spin,
+            &start.q,
+            &start.lambda,
+            &linearize::ramp(speed),
+        );
     }
-    let (gravity, loads) = match &sys {
+    let (mut q, mut lambda) = linearize::steady_state(
+        &with_gravity(0.0),
+        spin,
+        &start.q,
+        &start.lambda,
+        &linearize::ramp(speed),
+    )?;
+    for k in 1..=8 {
+        (q, lambda) =
+            linearize::steady_state(&with_gravity(k as f64 / 8.0), spin, &q, &lambda, &[speed])?;
+    }
+    Ok((q, lambda))
+}
+
+/// Whether the system can spin steadily about world z (the hub's axis): gravity along that
+/// axis only (a planar system's lies in the plane of rotation), and no loads, which keep their
+/// world direction while the system turns under them.
+fn steady_at_speed(sys: &Mechanics) -> Result<(), EngineError> {
+    let (across, loads) = match sys {
         Mechanics::Planar(s) => (
-            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            s.gravity
+                .filter(|g| g.norm() > 0.0)
+                .map(|g| [g[0], g[1], 0.0]),
             s.loads
                 .iter()
                 .any(|l| l.force.norm() > 0.0 || l.torque != 0.0 || l.inputs.is_some()),
         ),
         Mechanics::Spatial(s, _) => (
-            s.gravity.is_some_and(|g| g.norm() > 0.0),
+            s.gravity
+                .filter(|g| g[0].hypot(g[1]) > 1e-12 * g.norm())
+                .map(|g| [g[0], g[1], g[2]]),
             !s.loads.is_empty(),
         ),
     };
-    if gravity || loads {
+    if let Some(g) = across {
+        return Err(modes_error(format!(
+            "gravity {g:?} m/s² has a part across the hub's axis (world z): it turns in the \
+             co-rotating frame, so the spinning state is periodic, not steady. At speed, gravity \
+             must lie along world z (a 3D scene); it is linearized at rest"
+        )));
+    }
+    if loads {
         return Err(modes_error(
-            "gravity or a load makes the spinning state periodic, not steady: set them to \
-             zero to linearize at speed"
+            "a load keeps its world direction while the scene turns under it, so the spinning \
+             state is periodic, not steady: loads are linearized at rest only"
                 .into(),
         ));
     }
-    let (q, lambda) = linearize::steady_state(&sys, &spin, &st.q, &st.lambda, speed)?;
-    Ok((linearize::corotating(&sys, &spin, &q, &lambda, speed)?, st))
+    Ok(())
 }
 
 /// The hub joint at speed: the one named, else the one revolute joint to `world` with a motion

@@ -80,6 +80,10 @@ pub enum Command {
         /// The Campbell diagram's files, without extension [default: <scene>_campbell].
         #[arg(short, long, value_name = "PREFIX")]
         output: Option<PathBuf>,
+        /// Threads computing the Campbell diagram's speeds [default: all cores]; the CSV is
+        /// the same as a serial run's, byte for byte.
+        #[arg(long, value_name = "N", requires = "campbell", value_parser = clap::value_parser!(u64).range(1..=1024))]
+        jobs: Option<u64>,
     },
     /// Write the JSON Schema of scene files (shipped as scenes/scene.schema.json; a scene whose
     /// first line is `#:schema ./scene.schema.json` is completed and checked by Taplo-based
@@ -187,6 +191,7 @@ pub fn run_with_engines(
             equilibrium,
             campbell,
             output,
+            jobs,
         } => {
             let options = fmu_beam::ModeOptions {
                 lock,
@@ -196,7 +201,10 @@ pub fn run_with_engines(
                 equilibrium,
             };
             match campbell {
-                Some(spec) => campbell_cmd(&scene, count, options, &spec, output, out),
+                Some(spec) => {
+                    let jobs = jobs.map_or(0, |n| n as usize);
+                    campbell_cmd(&scene, count, options, &spec, output, jobs, out)
+                }
                 None => modes_cmd(&scene, count, &options, out),
             }
         }

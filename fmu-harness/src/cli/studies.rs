@@ -119,13 +119,15 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
     .map_err(stdout_err)
 }
 
-/// `modes --campbell`: the first `count` frequencies at each speed, as CSV and PNG.
+/// `modes --campbell`: the first `count` frequencies at each speed, as CSV and PNG, the speeds
+/// computed on `jobs` threads (0: all cores).
 pub(super) fn campbell_cmd(
     scene_path: &Path,
     count: usize,
     options: fmu_beam::ModeOptions,
     spec: &str,
     output: Option<PathBuf>,
+    jobs: usize,
     out: &mut dyn Write,
 ) -> Result<(), HarnessError> {
     let speeds = modes::campbell::parse_speeds(spec)?;
@@ -140,17 +142,12 @@ pub(super) fn campbell_cmd(
     let (csv, png) = (with(".csv"), with(".png"));
     // both files are looked at before the first eigenvalue problem
     crate::output_file::check_all([csv.as_path(), &png])?;
-    let mut frequencies = Vec::with_capacity(speeds.len());
-    let mut last = None;
-    for &speed in &speeds {
-        let o = fmu_beam::ModeOptions {
-            speed,
-            ..options.clone()
-        };
-        let m = modes::modes_of(&scene, &origin, &o)?;
-        frequencies.push(m.frequencies.iter().copied().take(count).collect());
-        last = Some(m);
-    }
+    let all = modes::campbell::modes_at_speeds(&scene, &origin, &options, &speeds, jobs)?;
+    let frequencies = all
+        .iter()
+        .map(|m| m.frequencies.iter().copied().take(count).collect())
+        .collect();
+    let last = all.last();
     let d = modes::campbell::Diagram {
         speeds,
         frequencies,
@@ -158,7 +155,12 @@ pub(super) fn campbell_cmd(
     crate::output_file::write_atomically(&csv, d.csv().as_bytes())?;
     let title = format!("{}: Campbell diagram", scene.name);
     crate::output_file::write_atomically(&png, &d.png(&title, 800, 560))?;
-    let m = last.expect("at least two speeds");
+    let Some(m) = last else {
+        return Err(HarnessError::Input {
+            origin: "--campbell".into(),
+            message: "no speeds".into(),
+        });
+    };
     let text = format!(
         "Campbell diagram of {} modes at {} speeds from {} to {} rad/s (hub '{}'; joints \
          locked: {}): wrote {} and {}\n",

@@ -9,7 +9,9 @@ use embedded_graphics::pixelcolor::Rgb888;
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
 use embedded_graphics::text::{Alignment, Text};
+use fmu_beam::{ModeOptions, Modes, Scene};
 use std::f64::consts::TAU;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Hub speeds `START:STOP:COUNT` (rad/s), COUNT ≥ 2 points evenly spaced, ends included.
 pub fn parse_speeds(spec: &str) -> Result<Vec<f64>, HarnessError> {
@@ -35,6 +37,60 @@ pub fn parse_speeds(spec: &str) -> Result<Vec<f64>, HarnessError> {
     Ok((0..n)
         .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
         .collect())
+}
+
+/// The modes of `scene` at each of `speeds` (the other options as given), computed on `jobs`
+/// threads (at most one per speed; 0: all cores), each taking the next speed from a shared
+/// counter. Each speed's modes are computed alone, so the result is a serial run's, in speed
+/// order; an error is the one of the first speed that failed (later speeds are not started).
+pub fn modes_at_speeds(
+    scene: &Scene,
+    origin: &str,
+    options: &ModeOptions,
+    speeds: &[f64],
+    jobs: usize,
+) -> Result<Vec<Modes>, HarnessError> {
+    let jobs = if jobs == 0 { default_jobs() } else { jobs }.clamp(1, speeds.len().max(1));
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let run = || {
+        let mut done = Vec::new();
+        loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            if k >= speeds.len() || failed.load(Ordering::Relaxed) {
+                return done;
+            }
+            let o = ModeOptions {
+                speed: speeds[k],
+                ..options.clone()
+            };
+            let m = super::modes_of(scene, origin, &o);
+            failed.fetch_or(m.is_err(), Ordering::Relaxed);
+            done.push((k, m));
+        }
+    };
+    let mut results: Vec<(usize, Result<Modes, HarnessError>)> = if jobs == 1 {
+        run()
+    } else {
+        std::thread::scope(|s| {
+            let workers: Vec<_> = (0..jobs).map(|_| s.spawn(run)).collect();
+            workers
+                .into_iter()
+                .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    };
+    results.sort_by_key(|(k, _)| *k);
+    let mut out = Vec::with_capacity(speeds.len());
+    for (_, m) in results {
+        out.push(m?);
+    }
+    Ok(out)
+}
+
+/// The threads a study runs on by default: every core the process may use.
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// One row per speed: the speed (rad/s) and the first frequencies (Hz).

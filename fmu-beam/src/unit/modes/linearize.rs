@@ -34,6 +34,8 @@ pub struct Linear {
     /// The free motions that deform no beam, in the coordinates y of the reduced matrices
     /// (r × p, orthonormal columns).
     pub rigid: DMatrix<f64>,
+    /// N (n × r, orthonormal columns): a free motion y is δq = N y on the system's coordinates.
+    pub basis: DMatrix<f64>,
 }
 
 /// How the coordinates turn with the whole system about the world z axis: each body's
@@ -117,23 +119,28 @@ fn step_q<E: Equations>(sys: &E) -> f64 {
     1e-6 * sys.length_scale().max(1e-3)
 }
 
-/// The coordinates and multipliers of the steady state spinning at `omega` about the origin
-/// (the hub's world frame), from the rest state (q0, λ0): Newton on r(q, v(q), a(q)) + Gᵀλ = 0,
-/// g(q, 0) = 0, its q-columns by central differences, in 8 steps of speed from rest.
+/// 8 equal steps of speed from rest to `omega`.
+pub fn ramp(omega: f64) -> Vec<f64> {
+    (1..=8).map(|s| omega * s as f64 / 8.0).collect()
+}
+
+/// The coordinates and multipliers of the steady state spinning about the origin (the hub's
+/// world frame) at the last of `speeds`, from (q0, λ0): Newton on r(q, v(q), a(q)) + Gᵀλ = 0,
+/// g(q, 0) = 0, its q-columns by central differences, at each of `speeds` in turn (from rest,
+/// [`ramp`]).
 pub fn steady_state<E: Equations>(
     sys: &E,
     spin: &Spin,
     q0: &DVector<f64>,
     lambda0: &DVector<f64>,
-    omega: f64,
+    speeds: &[f64],
 ) -> Result<(DVector<f64>, DVector<f64>), EngineError> {
+    let omega = speeds.last().copied().unwrap_or(0.0);
     let (n, m) = (sys.n(), sys.m());
     let (mut q, mut lambda) = (q0.clone(), lambda0.clone());
     let h = step_q(sys);
     let scale = sys.length_scale().max(1e-3);
-    const STEPS: usize = 8;
-    for s in 1..=STEPS {
-        let w = omega * s as f64 / STEPS as f64;
+    for &w in speeds {
         let f = |q: &DVector<f64>, lambda: &DVector<f64>| {
             let (v, a) = spin.rates(q, w);
             residual(sys, q, &v, &a, lambda)
@@ -258,6 +265,7 @@ pub fn corotating<E: Equations>(
         c: &bt * cn,
         k: &bt * kn,
         rigid,
+        basis,
     })
 }
 
