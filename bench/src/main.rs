@@ -376,11 +376,11 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<(), BenchError> {
             use work_precision::exhaustive as ex;
             let started = std::time::Instant::now();
             let mut progress = |line: &str| eprintln!("{line}");
+            std::fs::create_dir_all(&output)
+                .map_err(|e| BenchError::io(&output, "creating the folder", e))?;
             let all = match &points {
                 Some(path) => ex::read(path)?,
                 None => {
-                    std::fs::create_dir_all(&output)
-                        .map_err(|e| BenchError::io(&output, "creating the folder", e))?;
                     let mut all = Vec::new();
                     for case in ex::CASES
                         .iter()

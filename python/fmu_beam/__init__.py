@@ -22,9 +22,11 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 from fmu_beam._native import Error, Packaged, Scene, SceneError, __version__
+from fmu_beam._native import AccuracyStudy
 from fmu_beam import _native
 
 __all__ = ["Error", "Packaged", "Scene", "SceneError", "__version__", "engines", "main", "reference", "schema"]
+__all__ += ["AccuracyStudy"]
 
 
 def schema() -> Dict[str, Any]:

@@ -6,6 +6,7 @@
 //! fmu_beam's and fmu_harness's public API; every call goes through [`errors::guard`], so that
 //! an error is a Python exception and no panic reaches Python.
 
+mod accuracy;
 mod convert;
 mod engines;
 mod errors;
@@ -108,6 +109,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SceneError", py.get_type::<errors::SceneError>())?;
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::Packaged>()?;
+    m.add_class::<accuracy::AccuracyStudy>()?;
     m.add_function(wrap_pyfunction!(schema_text, m)?)?;
     m.add_function(wrap_pyfunction!(reference_text, m)?)?;
     m.add_function(wrap_pyfunction!(carried_engines, m)?)?;

@@ -361,6 +361,31 @@ pub fn study_with(
     })
 }
 
+/// The grid a study of `scene` compares its runs on: its start, communication step and number
+/// of steps (points after the start), from `opts` or the scene's experiment.
+pub fn grid(scene: &Scene, opts: &Options) -> Result<(f64, f64, usize), AccuracyError> {
+    let start = scene.experiment.start_time;
+    let stop = opts.stop.unwrap_or(scene.experiment.stop_time);
+    let comm = opts.comm.unwrap_or(scene.experiment.step_size);
+    if stop <= start {
+        return Err(AccuracyError::BadOption {
+            name: "stop",
+            value: stop.to_string(),
+            rule: "must be after the experiment's start time",
+        });
+    }
+    let points = ((stop - start) / comm).round().max(1.0);
+    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
+        return Err(AccuracyError::BadOption {
+            name: "comm",
+            value: comm.to_string(),
+            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
+                   is kept for the estimates): give a coarser --comm or a shorter --stop",
+        });
+    }
+    Ok((start, comm, points as usize))
+}
+
 /// The mesh a study re-centred on `first`'s choice runs at ([`recentre`]): the chosen mesh
 /// where it is not the scene's, else the halved one where its own estimated error times the
 /// safety factor is within the target; None where the study is not re-centred.
@@ -406,31 +431,21 @@ fn study_of(
             }
         }
     }
-    let start = base.experiment.start_time;
-    let stop = opts.stop.unwrap_or(base.experiment.stop_time);
-    let comm = opts.comm.unwrap_or(base.experiment.step_size);
-    if stop <= start {
-        return Err(AccuracyError::BadOption {
-            name: "stop",
-            value: stop.to_string(),
-            rule: "must be after the experiment's start time",
+    let (start, comm, n) = grid(&base, opts)?;
+    let reference = match (&opts.reference, &opts.reference_values) {
+        (_, Some(values)) => {
+            if values.len() != opts.outputs.len() || values.iter().any(|v| v.len() != n + 1) {
+                return Err(AccuracyError::BadOption {
+                    name: "reference",
+                    value: format!("{} series", values.len()),
+                    rule: "one series per output, on the study's grid",
+                }
+                .into());
+            }
+            Some(values.clone())
         }
-        .into());
-    }
-    let points = ((stop - start) / comm).round().max(1.0);
-    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
-        return Err(AccuracyError::BadOption {
-            name: "comm",
-            value: comm.to_string(),
-            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
-                   is kept for the estimates): give a coarser --comm or a shorter --stop",
-        }
-        .into());
-    }
-    let n = points as usize;
-    let reference = match &opts.reference {
-        Some((path, columns)) => Some(truth::read(path, columns, start, comm, n)?),
-        None => None,
+        (Some((path, columns)), None) => Some(truth::read(path, columns, start, comm, n)?),
+        (None, None) => None,
     };
     let h0 = opts.step.unwrap_or(comm.max(base.solver.max_step));
     let tol0 = opts

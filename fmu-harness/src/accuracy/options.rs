@@ -73,6 +73,8 @@ pub struct Options {
     pub jobs: Option<usize>,
     /// A reference CSV and its column for each output: each run's true error is reported.
     pub reference: Option<(std::path::PathBuf, Vec<String>)>,
+    /// The reference's values instead of a file: per output, on the study's grid ([`super::grid`]).
+    pub reference_values: Option<Vec<Vec<f64>>>,
     /// Draw a progress bar on standard error (when it is a terminal).
     pub progress: bool,
     /// Run the study again at another mesh where that may be cheaper (`study`'s `recentred`).
@@ -109,6 +111,7 @@ impl Options {
             max_seconds: DEFAULT_MAX_SECONDS,
             jobs: None,
             reference: None,
+            reference_values: None,
             progress: false,
             recentre: true,
         }

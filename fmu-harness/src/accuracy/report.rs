@@ -81,7 +81,7 @@ fn ladder_text(name: &str, l: &Option<Ladder>, nominal: f64) -> String {
 }
 
 /// Which share limits the error.
-fn limit_name(time: f64, mesh: f64, newton: f64) -> &'static str {
+pub fn limit_name(time: f64, mesh: f64, newton: f64) -> &'static str {
     if newton >= time && newton >= mesh {
         "Newton's tolerance"
     } else if time >= mesh {
