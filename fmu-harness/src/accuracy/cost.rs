@@ -1,13 +1,12 @@
 //! What a run costs, counted rather than timed, so that a study ranks settings and keeps to its
 //! budget the same way on an idle machine and a loaded one (issue 46 item 1). The engine counts
 //! its steps, Newton iterations and iteration matrices; the scene gives the size of what each
-//! of them works on. [`Shape::work`] weighs the counts by the work each does, in units of
-//! [`WORK_UNIT`] (about a CPU second on the machine where the weights were fitted:
-//! docs/accuracy.md, "What a run costs").
+//! of them works on. [`Shape::work`] weighs the counts by the work each does, in seconds of
+//! the machine where the weights were fitted (docs/accuracy.md, "What a run costs").
 
 use fmu_beam::Scene;
 
-/// What the engine counted over a run.
+/// What the engine counted over a run, and the grid it recorded.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Counts {
     /// Internal steps accepted.
@@ -16,6 +15,8 @@ pub struct Counts {
     pub iterations: u64,
     /// Iteration matrices evaluated and factorized.
     pub jacobians: u64,
+    /// Communication points recorded (the outputs read, the state interpolated there).
+    pub points: u64,
 }
 
 /// The sizes a run's work grows with, from the scene alone.
@@ -24,23 +25,23 @@ pub struct Shape {
     /// Unknowns of the iteration matrix (coordinates and constraint rows), n + m.
     pub unknowns: f64,
     /// The sum over floating frames (and rigid bodies) of their coordinates squared: each
-    /// frame's mass, stiffness and inertia blocks are dense over its own coordinates, so a
-    /// residual or an iteration matrix costs this much on top of what grows with n + m.
+    /// frame's mass, stiffness and inertia blocks are dense over its own coordinates, and an
+    /// iteration matrix is assembled and factorized block by block.
     pub blocks: f64,
     /// Coordinates of the largest frame (or body).
     pub largest: f64,
 }
 
-/// The work weighed as in [`Shape::work`] that takes about a CPU second where it was fitted.
-pub const WORK_UNIT: f64 = 1.0;
+/// Seconds per Newton iteration and unknown: a residual, its constraints and a solve with the
+/// factors grow with n + m (the factors are banded along a chain of frames).
+pub const PER_ITERATION_UNKNOWN: f64 = 7.8e-8;
 
-/// Weights of [`Shape::work`], fitted on the C2–C4 sweeps (docs/accuracy.md): seconds per
-/// (Newton iteration × unknown), per (iteration × block entry), per (iteration matrix ×
-/// block entry) and per (step × unknown).
-pub const PER_ITERATION_UNKNOWN: f64 = 1.0e-7;
-pub const PER_ITERATION_BLOCK: f64 = 1.0e-8;
-pub const PER_JACOBIAN_BLOCK: f64 = 1.0e-8;
-pub const PER_STEP_UNKNOWN: f64 = 1.0e-7;
+/// Seconds per iteration matrix and block entry: each frame's dense blocks evaluated and
+/// factorized.
+pub const PER_JACOBIAN_BLOCK: f64 = 4.3e-8;
+
+/// Seconds per communication point and unknown: the state interpolated and the outputs read.
+pub const PER_POINT_UNKNOWN: f64 = 3.2e-8;
 
 impl Shape {
     /// The shape of `scene` as the engine builds it (a 3D scene whose motion is planar runs
@@ -75,13 +76,39 @@ impl Shape {
         }
     }
 
-    /// The counted cost of a run of this shape: the same counts give the same number on every
-    /// machine and under any load.
+    /// The counted cost of a run of this shape, in seconds of the machine the weights were
+    /// fitted on (docs/accuracy.md, "What a run costs": within 1.11× of the CPU time, geometric
+    /// standard deviation, over the C2–C4 sweeps' runs of 0.05 s or more). The same counts give
+    /// the same number on every machine and under any load.
     pub fn work(&self, c: &Counts) -> f64 {
-        let (i, j, s) = (c.iterations as f64, c.jacobians as f64, c.steps as f64);
-        (i * (PER_ITERATION_UNKNOWN * self.unknowns + PER_ITERATION_BLOCK * self.blocks)
-            + j * PER_JACOBIAN_BLOCK * self.blocks
-            + s * PER_STEP_UNKNOWN * self.unknowns)
-            / WORK_UNIT
+        PER_ITERATION_UNKNOWN * c.iterations as f64 * self.unknowns
+            + PER_JACOBIAN_BLOCK * c.jacobians as f64 * self.blocks
+            + PER_POINT_UNKNOWN * c.points as f64 * self.unknowns
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The weights as documented: given counts on a given shape weigh one number, bit for bit.
+    #[test]
+    fn the_work_of_given_counts_is_one_number() {
+        let shape = Shape {
+            unknowns: 177.0,
+            blocks: 1620.0,
+            largest: 9.0,
+        };
+        let c = Counts {
+            steps: 86_207,
+            iterations: 199_973,
+            jacobians: 10_000,
+            points: 1000,
+        };
+        let w = shape.work(&c);
+        let expected =
+            7.8e-8 * 199_973.0 * 177.0 + 4.3e-8 * 10_000.0 * 1620.0 + 3.2e-8 * 1000.0 * 177.0;
+        assert_eq!(w.to_bits(), expected.to_bits());
+        assert_eq!(shape.work(&c).to_bits(), w.to_bits());
     }
 }

@@ -609,6 +609,7 @@ fn study_of(
             offset = 1;
         }
     }
+    r.forget();
     if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
         r.notes.push(
             "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
@@ -719,10 +720,15 @@ fn study_of(
             if let Some(m) =
                 recentre_mesh(j as i32 - offset as i32, halved_error, margin, opts.target)
             {
-                ahead_runs.extend((0..opts.levels).rev().map(|k| Setting {
-                    mesh: m,
-                    ..at(k, 0)
-                }));
+                // as deep as this study's ladder went (the finest first: the longest)
+                ahead_runs.extend(
+                    (0..time_runs.len().max(opts.levels))
+                        .rev()
+                        .map(|k| Setting {
+                            mesh: m,
+                            ..at(k, 0)
+                        }),
+                );
             }
         }
         r.speculate(&ahead_runs);

@@ -134,6 +134,7 @@ fn simulate_inner(
         steps: count("solver.steps"),
         iterations: count("solver.newton_iterations"),
         jacobians: count("solver.jacobians"),
+        points: job.n as u64,
     };
     Ok((values, counts))
 }
