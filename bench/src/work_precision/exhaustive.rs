@@ -386,7 +386,7 @@ pub fn sweep(
 /// The `i`-th step of the grid below `h0`: the time ladder's h0 / 2^k where i = 4k, else the
 /// quarter octave the study's relaxation reaches (h0 / 2^(i/4), rounded down to three digits).
 pub fn grid_step(h0: f64, i: usize) -> f64 {
-    if i % 4 == 0 {
+    if i.is_multiple_of(4) {
         h0 / 2f64.powi((i / 4) as i32)
     } else {
         let x = h0 / 2f64.powf(i as f64 / 4.0);

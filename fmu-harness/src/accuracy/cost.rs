@@ -106,7 +106,7 @@ mod tests {
             points: 1000,
         };
         let w = shape.work(&c);
-        let expected =
+        let expected: f64 =
             7.8e-8 * 199_973.0 * 177.0 + 4.3e-8 * 10_000.0 * 1620.0 + 3.2e-8 * 1000.0 * 177.0;
         assert_eq!(w.to_bits(), expected.to_bits());
         assert_eq!(shape.work(&c).to_bits(), w.to_bits());
