@@ -190,6 +190,9 @@ pub struct Study {
     pub incomplete: Option<String>,
     /// Runs run at once (the pool's workers; 1: one after another).
     pub jobs: usize,
+    /// Runs the workers ran ahead that the study did not ask for (stopped part-way or
+    /// finished), and their CPU seconds: what running ahead cost.
+    pub unused: (usize, f64),
     /// Runs of a first study that are not in `runs` (this one is re-centred on its mesh).
     pub earlier_runs: usize,
 }
@@ -355,8 +358,10 @@ pub fn study_with(
     if pool.stop.load(std::sync::atomic::Ordering::Relaxed) {
         return Err(AccuracyError::Interrupted.into());
     }
+    let unused = pool.unused();
     result.map(|mut s: Study| {
         s.jobs = jobs;
+        s.unused = unused;
         s
     })
 }
@@ -863,6 +868,7 @@ fn study_of(
         earlier_runs: 0,
         incomplete: r.incomplete,
         jobs: 1,
+        unused: (0, 0.0),
     };
     if let Some(reference) = &reference {
         truth::judge(&mut study, reference);

@@ -9,7 +9,7 @@
 use super::cost::Counts;
 use super::estimate::Series;
 use fmu_beam::{Engine, Scene};
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -150,6 +150,10 @@ struct Inner {
     states: HashMap<String, State>,
     queue: VecDeque<String>,
     shutdown: bool,
+    /// The jobs the study took.
+    taken: HashSet<String>,
+    /// Runs stopped before their end (gone past), and their CPU seconds.
+    stopped: (usize, f64),
 }
 
 /// The runs of one study, shared by its thread and the workers.
@@ -215,11 +219,29 @@ impl Pool {
             g = self.lock();
             if matches!(out.result, Err(Failure::Stopped)) {
                 g.states.remove(&key);
+                g.stopped.0 += 1;
+                g.stopped.1 += out.seconds;
             } else {
                 g.states.insert(key, State::Done(out));
             }
             self.changed.notify_all();
         }
+    }
+
+    /// What the workers ran and the study did not take: runs, CPU seconds (stopped part-way
+    /// or finished).
+    pub(super) fn unused(&self) -> (usize, f64) {
+        let g = self.lock();
+        let (mut n, mut seconds) = g.stopped;
+        for (k, s) in &g.states {
+            if let State::Done(o) = s {
+                if !g.taken.contains(k) {
+                    n += 1;
+                    seconds += o.seconds;
+                }
+            }
+        }
+        (n, seconds)
     }
 
     /// Ends the workers' loops (queued jobs are dropped, running ones stopped).
@@ -279,7 +301,11 @@ impl Pool {
         let mut g = self.lock();
         loop {
             match g.states.get(&key) {
-                Some(State::Done(o)) => return o.clone(),
+                Some(State::Done(o)) => {
+                    let o = o.clone();
+                    g.taken.insert(key);
+                    return o;
+                }
                 Some(State::Running(_)) => {
                     if interrupted() {
                         self.stop.store(true, Ordering::Relaxed);
@@ -334,7 +360,8 @@ impl Pool {
                     if matches!(out.result, Err(Failure::Stopped)) {
                         g.states.remove(&key);
                     } else {
-                        g.states.insert(key, State::Done(out.clone()));
+                        g.states.insert(key.clone(), State::Done(out.clone()));
+                        g.taken.insert(key);
                     }
                     self.changed.notify_all();
                     return out;

@@ -325,6 +325,13 @@ pub fn markdown(study: &Study) -> String {
         study.jobs,
         if study.jobs == 1 { "" } else { "s" }
     );
+    if study.jobs > 1 {
+        let _ = writeln!(
+            s,
+            "- run ahead and not asked for: {} runs, {:.2} CPU s (not in the table)",
+            study.unused.0, study.unused.1
+        );
+    }
     for n in &study.notes {
         let _ = writeln!(s, "- {n}");
     }
@@ -360,6 +367,8 @@ pub fn json(study: &Study) -> String {
         "cpu_s": study.cpu_seconds,
         "wall_s": study.wall_seconds,
         "jobs": study.jobs,
+        "unused_runs": study.unused.0,
+        "unused_cpu_s": study.unused.1,
     });
     format!("{v:#}\n")
 }
