@@ -141,6 +141,37 @@ enum Command {
         #[arg(long)]
         header: bool,
     },
+    /// The exhaustive sweep behind the accuracy study's choice (issue 46 item 1): C2–C4 over
+    /// every mesh the study reaches and the quarter octaves of its steps, against the exact
+    /// references, counted and timed; the cheapest setting meeting each target with the
+    /// study's safety factor against the study's choice (`build/accuracy/<case>-<target>/`),
+    /// and the fit of the counted costs to CPU time; writes exhaustive.csv and EXHAUSTIVE.md.
+    Exhaustive {
+        /// Directory of the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Directory of the reference CSVs.
+        #[arg(long, default_value = "bench/reference")]
+        references: PathBuf,
+        /// Output directory.
+        #[arg(short, long, default_value = "build/bench")]
+        output: PathBuf,
+        /// Only these cases (c2, c3_elastic, c3_rigid, c4_omega10, c4_omega4).
+        #[arg(long, value_delimiter = ',')]
+        cases: Vec<String>,
+        /// CPU seconds of a run above which a mesh's finer steps are left out.
+        #[arg(long, default_value_t = 30.0)]
+        max_cpu: f64,
+        /// The points of an earlier sweep (its exhaustive.csv) instead of a new one.
+        #[arg(long)]
+        points: Option<PathBuf>,
+        /// The studies' folders (`make bench-accuracy`'s build/accuracy).
+        #[arg(long, default_value = "build/accuracy")]
+        studies: PathBuf,
+        /// Timed rounds of each choice against the sweep's cheapest.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+    },
     /// Dense against sparse LU of the iteration matrix: C2's pendulum and C4's spin-up with
     /// k = 5…80 substructures and C1's beam with e elements, at fixed steps; CPU time per step,
     /// per factorization and per solve; writes LINEAR.md and linear_solvers.csv.
@@ -331,6 +362,60 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<(), BenchError> {
                 writeln!(out, "{}", choice::HEADER).map_err(stdout_err)?;
             }
             writeln!(out, "{row}").map_err(stdout_err)?;
+        }
+        Command::Exhaustive {
+            scenes,
+            references,
+            output,
+            cases,
+            max_cpu,
+            points,
+            studies,
+            rounds,
+        } => {
+            use work_precision::exhaustive as ex;
+            let started = std::time::Instant::now();
+            let mut progress = |line: &str| eprintln!("{line}");
+            std::fs::create_dir_all(&output)
+                .map_err(|e| BenchError::io(&output, "creating the folder", e))?;
+            let all = match &points {
+                Some(path) => ex::read(path)?,
+                None => {
+                    let mut all = Vec::new();
+                    for case in ex::CASES
+                        .iter()
+                        .filter(|c| cases.is_empty() || cases.iter().any(|n| n == c.name))
+                    {
+                        all.extend(ex::sweep(
+                            &scenes,
+                            &references,
+                            case,
+                            max_cpu,
+                            &mut progress,
+                        )?);
+                        let csv = output.join("exhaustive.csv");
+                        std::fs::write(&csv, ex::csv(&all))
+                            .map_err(|e| BenchError::io(&csv, "writing the points", e))?;
+                    }
+                    all
+                }
+            };
+            let swept = started.elapsed().as_secs_f64();
+            let studies = studies.is_dir().then_some(studies.as_path());
+            let table = ex::report(&scenes, &all, studies, rounds, &mut progress);
+            let text = format!(
+                "# The accuracy study against an exhaustive sweep\n\n{} runs{}.\n\n{table}\n{}",
+                all.len(),
+                if points.is_some() {
+                    String::new()
+                } else {
+                    format!(", swept in {swept:.0} s wall")
+                },
+                ex::fit_table(&all)
+            );
+            let md = output.join("EXHAUSTIVE.md");
+            std::fs::write(&md, &text).map_err(|e| BenchError::io(&md, "writing the report", e))?;
+            out.write_all(text.as_bytes()).map_err(stdout_err)?;
         }
         Command::LinearSolvers {
             scenes,

@@ -15,6 +15,7 @@
 pub mod cases;
 pub mod choice;
 pub mod exact;
+pub mod exhaustive;
 pub mod overhead;
 pub mod peer;
 pub mod peer_run;

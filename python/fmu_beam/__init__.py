@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 from fmu_beam._native import Error, Packaged, Scene, SceneError, SimulationError, Unit, __version__
+from fmu_beam._native import AccuracyStudy
 from fmu_beam import _native
 from fmu_beam._sweep import sweep
 from fmu_beam._modes import Modes
@@ -40,7 +41,7 @@ __all__ = [
     "schema",
     "sweep",
 ]
-__all__ += ["Modes"]
+__all__ += ["Modes", "AccuracyStudy"]
 
 
 def schema() -> Dict[str, Any]:

@@ -167,6 +167,34 @@ class Scene:
         followed linearly (``interpolation="linear"``, through the input derivatives) or held
         (``"hold"``), or a callable ``(t, outputs) -> {input: value}`` called at every
         communication point. A step the unit cannot take raises :class:`SimulationError`."""
+    def accuracy(
+        self,
+        output: Union[str, Sequence[str]],
+        target: float,
+        stop: Optional[float] = None,
+        comm: Optional[float] = None,
+        step: Optional[float] = None,
+        newton: Optional[float] = None,
+        levels: int = 5,
+        mesh_levels: int = 3,
+        recentre: bool = True,
+        max_runs: int = 60,
+        reference: Optional[Any] = None,
+        column: Optional[Union[str, Sequence[str]]] = None,
+        jobs: Optional[int] = None,
+        max_work: Optional[float] = None,
+        max_seconds: Optional[float] = None,
+    ) -> "AccuracyStudy":
+        """The accuracy study of ``fmu-beam accuracy`` (docs/accuracy.md): the cheapest fixed
+        step, Newton tolerance and mesh whose error in ``output`` (a name or a list: the largest
+        over the grid of |y - y*| / max |y*|) meets ``target``, ranked and budgeted by counted
+        work (the same choice on any machine and under any load), run on ``jobs`` cores
+        (default: all) without the GIL; Ctrl-C stops it (KeyboardInterrupt). ``reference``: a
+        CSV path (time first; ``column`` names its column per output) or a pandas DataFrame
+        (``column``, default the outputs' names) or Series indexed by time, holding the study's
+        grid times: each run's true error is reported beside its estimate. ``max_work``: the
+        counted budget (default 600); ``max_seconds``: a wall-clock safety stop (default 3600),
+        whose firing makes the study INCOMPLETE."""
     def __eq__(self, other: object) -> bool: ...
     def __reduce__(self) -> Any: ...
 
@@ -209,6 +237,43 @@ class Unit:
         """The warnings logged since the last call."""
     def units(self, names: Sequence[str]) -> Dict[str, Optional[str]]:
         """The unit of each name (None: dimensionless)."""
+
+class AccuracyStudy:
+    """A finished accuracy study (:meth:`Scene.accuracy`)."""
+
+    choice: Optional[Dict[str, Any]]
+    """The chosen setting: step (s), newton (tolerance), mesh (text), work (counted), cpu_s;
+    None where no setting of the ladders meets the target."""
+    scene: Optional[Scene]
+    """The scene at the chosen setting, or None."""
+    estimate: Optional[float]
+    """The chosen setting's predicted error (the study's norm), or None."""
+    time_share: Optional[float]
+    mesh_share: Optional[float]
+    newton_share: Optional[float]
+    """Its error's parts: the step's, the mesh's, Newton's (the difference at tolerance / 100)."""
+    limited_by: Optional[str]
+    """Which share limits the error."""
+    margin: float
+    """The safety factor the prediction is held to: 1.25 where every order is observed, else 3."""
+    target: float
+    outputs: List[str]
+    notes: List[str]
+    """Remarks: runs the budget left out, a relaxed setting that missed, the re-centring."""
+    incomplete: Optional[str]
+    """Why the study stopped before its end (its wall-clock safety stop), else None."""
+    work: float
+    cpu_seconds: float
+    wall_seconds: float
+    jobs: int
+    runs: Any
+    """A pandas DataFrame, one row per run: role, step, newton, mesh, stiffening_switched,
+    estimated_error, error_<output>, true_error (with a reference), work, cpu_s, steps,
+    newton_iterations, jacobians, status."""
+    def markdown(self) -> str:
+        """The report of ``fmu-beam accuracy``."""
+    def csv(self) -> str:
+        """The runs as the command's accuracy.csv."""
 
 def schema_text() -> str:
     """The JSON Schema of scene files, as text."""

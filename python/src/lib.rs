@@ -6,6 +6,7 @@
 //! fmu_beam's and fmu_harness's public API; every call goes through [`errors::guard`], so that
 //! an error is a Python exception and no panic reaches Python.
 
+mod accuracy;
 mod convert;
 mod engines;
 mod errors;
@@ -112,6 +113,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::Packaged>()?;
     m.add_class::<unit::PyUnit>()?;
+    m.add_class::<accuracy::AccuracyStudy>()?;
     m.add_function(wrap_pyfunction!(schema_text, m)?)?;
     m.add_function(wrap_pyfunction!(reference_text, m)?)?;
     m.add_function(wrap_pyfunction!(carried_engines, m)?)?;

@@ -256,6 +256,53 @@ impl PyScene {
         })
     }
 
+    /// The accuracy study of `fmu-beam accuracy` (docs/accuracy.md): the cheapest fixed step,
+    /// Newton tolerance and mesh whose error in `output` (a name or a list) meets `target`,
+    /// ranked by counted work, run on `jobs` cores (default: all) without the GIL; Ctrl-C stops
+    /// it. `reference`: a CSV path (with `column`) or a pandas DataFrame/Series indexed by time.
+    #[pyo3(signature = (output, target, stop = None, comm = None, step = None, newton = None,
+        levels = 5, mesh_levels = 3, recentre = true, max_runs = 60, reference = None,
+        column = None, jobs = None, max_work = None, max_seconds = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn accuracy<'py>(
+        &self,
+        py: Python<'py>,
+        output: Bound<'py, PyAny>,
+        target: f64,
+        stop: Option<f64>,
+        comm: Option<f64>,
+        step: Option<f64>,
+        newton: Option<f64>,
+        levels: usize,
+        mesh_levels: usize,
+        recentre: bool,
+        max_runs: usize,
+        reference: Option<Bound<'py, PyAny>>,
+        column: Option<Bound<'py, PyAny>>,
+        jobs: Option<usize>,
+        max_work: Option<f64>,
+        max_seconds: Option<f64>,
+    ) -> PyResult<crate::accuracy::AccuracyStudy> {
+        let args = crate::accuracy::Args {
+            output,
+            target,
+            stop,
+            comm,
+            step,
+            newton,
+            levels,
+            mesh_levels,
+            recentre,
+            max_runs,
+            reference,
+            column,
+            jobs,
+            max_work,
+            max_seconds,
+        };
+        crate::accuracy::study(py, &self.scene, &self.origin, args)
+    }
+
     fn __eq__(&self, other: PyRef<'_, PyScene>) -> bool {
         self.scene == other.scene
     }

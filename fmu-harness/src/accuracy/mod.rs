@@ -19,19 +19,22 @@
 //! whose steps share the runs and their estimates; split, each part would take most of them as
 //! arguments.
 
+pub mod cost;
 pub mod estimate;
 mod options;
 pub mod plot;
+mod pool;
 mod recentre;
 pub mod report;
 mod runner;
 pub mod truth;
 
+use cost::Counts;
 use estimate::{distance, distances, peaks, richardson, shifted, Ladder, Series};
 use fmu_beam::{Engine, Scene, VarType};
-pub use options::{AccuracyError, Options};
+pub use options::{AccuracyError, Options, DEFAULT_MAX_SECONDS, DEFAULT_MAX_WORK, MAX_JOBS};
+use pool::Pool;
 use runner::{coarsenable, fine_end, mesh_text, refinable, scene_at, Grid, Runner};
-use std::path::Path;
 use std::time::Instant;
 
 /// The generalized-α scheme's order in time (Chung & Hulbert 1993, with α_m, α_f, β, γ from ρ∞).
@@ -47,10 +50,6 @@ pub const NEWTON_PER_HALVING: f64 = 4.0;
 
 /// The Newton probe divides the chosen setting's tolerance by this.
 pub const NEWTON_PROBE: f64 = 100.0;
-
-/// Below this, the scheduler's CPU account (in ticks of a few ms) is too coarse to rank runs:
-/// the run's wall time is taken instead.
-pub const COARSE_CPU: f64 = 0.05;
 
 /// What a run is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,10 +100,13 @@ pub struct Run {
     pub setting: Setting,
     /// The outputs on the grid, or why the run failed.
     pub result: Result<Series, String>,
-    /// CPU seconds of the run (this thread's; wall seconds where Linux does not say, or where
-    /// the run is shorter than [`COARSE_CPU`]).
+    /// CPU seconds of the run (its thread's; wall seconds where Linux does not say): reported,
+    /// never used to decide (they change with the load).
     pub seconds: f64,
-    pub steps: i64,
+    /// What the engine counted, and the counted work ([`cost::Shape::work`]) the study ranks
+    /// settings and keeps to its budget by.
+    pub counts: Counts,
+    pub work: f64,
     /// Per output, the estimated error (against the study's limit); empty until estimated.
     pub errors: Vec<f64>,
     /// Per output, the error against `--reference` (empty without one).
@@ -139,8 +141,8 @@ pub struct Choice {
     pub expected_difference: f64,
     pub time_share: f64,
     pub mesh_share: f64,
-    /// CPU seconds predicted from the ladders' runs.
-    pub predicted_seconds: f64,
+    /// Counted work predicted from the ladders' runs.
+    pub predicted_work: f64,
     /// Its run's index in [`Study::runs`].
     pub run: usize,
     /// The finer run's index, and the difference to it (the study's norm).
@@ -178,10 +180,19 @@ pub struct Study {
     pub choice: Option<Choice>,
     /// Runs left out by the budget, and other remarks.
     pub notes: Vec<String>,
-    /// The study's own cost: CPU seconds of its runs, wall seconds (a first study's included,
-    /// where this one is re-centred).
+    /// The study's own cost: counted work and CPU seconds of its runs, wall seconds (a first
+    /// study's included, where this one is re-centred).
+    pub work: f64,
     pub cpu_seconds: f64,
     pub wall_seconds: f64,
+    /// Why the study stopped before its end (its wall-clock safety stop fired): its choice is
+    /// then that of the runs before the stop, and may differ from a complete study's.
+    pub incomplete: Option<String>,
+    /// Runs run at once (the pool's workers; 1: one after another).
+    pub jobs: usize,
+    /// Runs the workers ran ahead that the study did not ask for (stopped part-way or
+    /// finished), and their CPU seconds: what running ahead cost.
+    pub unused: (usize, f64),
     /// Runs of a first study that are not in `runs` (this one is re-centred on its mesh).
     pub earlier_runs: usize,
 }
@@ -283,26 +294,128 @@ fn ladder_done(r: &Runner, rungs: &[Option<usize>], nominal: f64, target: f64) -
     meets && !unsettled
 }
 
+/// The checks of a chosen `setting`: the finer run (step halved, Newton's tolerance / 4, the
+/// mesh doubled where there is one), the Newton probe and the stiffening switched (where there
+/// is a mesh: the third is run only then).
+fn checks(setting: Setting, has_mesh: bool) -> [Setting; 3] {
+    [
+        Setting {
+            step: setting.step / 2.0,
+            newton: (setting.newton / NEWTON_PER_HALVING).max(1e-14),
+            mesh: setting.mesh + i32::from(has_mesh),
+            stiffening_switched: false,
+        },
+        Setting {
+            newton: (setting.newton / NEWTON_PROBE).max(1e-15),
+            ..setting
+        },
+        Setting {
+            stiffening_switched: true,
+            ..setting
+        },
+    ]
+}
+
 /// `x` rounded down to three significant digits (a step a scene can carry as written).
 fn three_digits_down(x: f64) -> f64 {
     let m = 10f64.powi(2 - x.log10().floor() as i32);
     (x * m).floor() / m
 }
 
-/// Runs the study of `scene_path`; where it chooses a mesh other than the scene's, or the
-/// halved mesh could meet the target, runs it again at that mesh ([`recentre`]).
-pub fn study(scene_path: &Path, opts: &Options) -> Result<Study, crate::HarnessError> {
+/// Runs the study of `scene`; where it chooses a mesh other than the scene's, or the halved
+/// mesh could meet the target, runs it again at that mesh ([`recentre`]).
+pub fn study(scene: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> {
+    study_with(scene, opts, &|| false)
+}
+
+/// [`study`], asking `interrupted` about five times a second (the Python API passes
+/// `check_signals`): once it says yes, every run stops and the study returns
+/// [`AccuracyError::Interrupted`].
+pub fn study_with(
+    scene: &Scene,
+    opts: &Options,
+    interrupted: &dyn Fn() -> bool,
+) -> Result<Study, crate::HarnessError> {
     opts.check()?;
-    let base = Scene::load(scene_path)?;
-    let first = study_of(&base, opts)?;
-    Ok(if opts.recentre {
-        recentre::recentred(&base, opts, first)
-    } else {
-        first
+    let jobs = opts.jobs();
+    let workers = if jobs > 1 { jobs } else { 0 };
+    let pool = Pool::new(workers, opts.max_seconds);
+    let result = std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| pool.work());
+        }
+        let out = (|| {
+            let first = study_of(scene, opts, &pool, interrupted, opts.recentre)?;
+            Ok(if opts.recentre {
+                recentre::recentred(scene, opts, first, &pool, interrupted)
+            } else {
+                first
+            })
+        })();
+        pool.shut_down();
+        out
+    });
+    if pool.stop.load(std::sync::atomic::Ordering::Relaxed) {
+        return Err(AccuracyError::Interrupted.into());
+    }
+    let unused = pool.unused();
+    result.map(|mut s: Study| {
+        s.jobs = jobs;
+        s.unused = unused;
+        s
     })
 }
 
-fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> {
+/// The grid a study of `scene` compares its runs on: its start, communication step and number
+/// of steps (points after the start), from `opts` or the scene's experiment.
+pub fn grid(scene: &Scene, opts: &Options) -> Result<(f64, f64, usize), AccuracyError> {
+    let start = scene.experiment.start_time;
+    let stop = opts.stop.unwrap_or(scene.experiment.stop_time);
+    let comm = opts.comm.unwrap_or(scene.experiment.step_size);
+    if stop <= start {
+        return Err(AccuracyError::BadOption {
+            name: "stop",
+            value: stop.to_string(),
+            rule: "must be after the experiment's start time",
+        });
+    }
+    let points = ((stop - start) / comm).round().max(1.0);
+    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
+        return Err(AccuracyError::BadOption {
+            name: "comm",
+            value: comm.to_string(),
+            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
+                   is kept for the estimates): give a coarser --comm or a shorter --stop",
+        });
+    }
+    Ok((start, comm, points as usize))
+}
+
+/// The mesh a study re-centred on `first`'s choice runs at ([`recentre`]): the chosen mesh
+/// where it is not the scene's, else the halved one where its own estimated error times the
+/// safety factor is within the target; None where the study is not re-centred.
+pub(crate) fn recentre_mesh(
+    chosen_mesh: i32,
+    halved_error: Option<f64>,
+    margin: f64,
+    target: f64,
+) -> Option<i32> {
+    match chosen_mesh {
+        0 if halved_error.is_some_and(|e| e * margin < target) => Some(-1),
+        0 => None,
+        m => Some(m),
+    }
+}
+
+/// One study of `base` (its runs through `pool`); `ahead`: a re-centred study may follow,
+/// whose time ladder is handed to the pool as soon as the choice says which mesh it runs at.
+fn study_of(
+    base: &Scene,
+    opts: &Options,
+    pool: &Pool,
+    interrupted: &dyn Fn() -> bool,
+    ahead: bool,
+) -> Result<Study, crate::HarnessError> {
     let base = base.clone();
     {
         let e = Engine::new(base.clone());
@@ -323,31 +436,21 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
             }
         }
     }
-    let start = base.experiment.start_time;
-    let stop = opts.stop.unwrap_or(base.experiment.stop_time);
-    let comm = opts.comm.unwrap_or(base.experiment.step_size);
-    if stop <= start {
-        return Err(AccuracyError::BadOption {
-            name: "stop",
-            value: stop.to_string(),
-            rule: "must be after the experiment's start time",
+    let (start, comm, n) = grid(&base, opts)?;
+    let reference = match (&opts.reference, &opts.reference_values) {
+        (_, Some(values)) => {
+            if values.len() != opts.outputs.len() || values.iter().any(|v| v.len() != n + 1) {
+                return Err(AccuracyError::BadOption {
+                    name: "reference",
+                    value: format!("{} series", values.len()),
+                    rule: "one series per output, on the study's grid",
+                }
+                .into());
+            }
+            Some(values.clone())
         }
-        .into());
-    }
-    let points = ((stop - start) / comm).round().max(1.0);
-    if points * opts.outputs.len() as f64 > MAX_VALUES as f64 {
-        return Err(AccuracyError::BadOption {
-            name: "comm",
-            value: comm.to_string(),
-            rule: "the grid times the outputs may hold at most 1e6 values per run (every run \
-                   is kept for the estimates): give a coarser --comm or a shorter --stop",
-        }
-        .into());
-    }
-    let n = points as usize;
-    let reference = match &opts.reference {
-        Some((path, columns)) => Some(truth::read(path, columns, start, comm, n)?),
-        None => None,
+        (Some((path, columns)), None) => Some(truth::read(path, columns, start, comm, n)?),
+        (None, None) => None,
     };
     let h0 = opts.step.unwrap_or(comm.max(base.solver.max_step));
     let tol0 = opts
@@ -376,9 +479,12 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         runs: Vec::new(),
         started: Instant::now(),
         max_runs: opts.max_runs,
-        max_seconds: opts.max_seconds,
+        max_work: opts.max_work,
         notes: Vec::new(),
         bar,
+        pool,
+        interrupted,
+        incomplete: None,
     };
     let at = |level: usize, mesh: i32| Setting {
         step: h0 / 2f64.powi(level as i32),
@@ -392,6 +498,10 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
     // order is not observed and its finest difference is above a tenth of the target
     let mut time_runs: Vec<Option<usize>> = Vec::new();
     let mut last_cost = 0.0;
+    // run ahead: the asked steps, finest (longest) first, and one step past them
+    let asked: Vec<Setting> = (0..=opts.levels).rev().map(|k| at(k, 0)).collect();
+    r.speculate(&asked[1..]);
+    r.speculate(&asked[..1]);
     for k in 0..MAX_TIME_LEVELS {
         if k >= opts.levels
             && (time_runs.last() == Some(&None)
@@ -399,14 +509,24 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         {
             break;
         }
+        if k + 1 >= opts.levels && k + 1 < MAX_TIME_LEVELS {
+            r.speculate(&[at(k + 1, 0)]);
+        }
         let i = r.run(Role::Time, at(k, 0), 2.0 * last_cost);
         if let Some(i) = i {
-            last_cost = r.runs[i].seconds;
+            last_cost = r.runs[i].work;
         }
         time_runs.push(i);
     }
+    r.forget();
     let time_tail = fine_end(&r, &time_runs);
     let Some(&finest) = time_tail.last() else {
+        if r.incomplete.is_some() {
+            return Err(AccuracyError::Stopped {
+                seconds: opts.max_seconds,
+            }
+            .into());
+        }
         let first = r.runs.iter().find_map(|x| x.result.clone().err());
         return Err(AccuracyError::NothingRan {
             step: h0,
@@ -443,7 +563,16 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         .unwrap_or(tail_levels[tail_levels.len() - 1]);
     let mut mesh_runs: Vec<Option<usize>> = vec![time_runs[mesh_level]];
     if has_mesh {
-        let mut cost = time_runs[mesh_level].map_or(0.0, |i| r.runs[i].seconds);
+        // run ahead: the asked meshes, finest first, the halved one, and one mesh past them
+        let mut ahead_meshes: Vec<Setting> = (1..opts.mesh_levels.max(2))
+            .rev()
+            .map(|j| at(mesh_level, j as i32))
+            .collect();
+        if coarsenable(&base) {
+            ahead_meshes.push(at(mesh_level, -1));
+        }
+        r.speculate(&ahead_meshes);
+        let mut cost = time_runs[mesh_level].map_or(0.0, |i| r.runs[i].work);
         for j in 1..MAX_MESH_LEVELS {
             if j >= opts.mesh_levels
                 && (mesh_runs.last() == Some(&None)
@@ -451,9 +580,12 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
             {
                 break;
             }
+            if j + 1 >= opts.mesh_levels && j + 1 < MAX_MESH_LEVELS {
+                r.speculate(&[at(mesh_level, j as i32 + 1)]);
+            }
             let i = r.run(Role::Mesh, at(mesh_level, j as i32), 2.5 * cost);
             if let Some(i) = i {
-                cost = r.runs[i].seconds;
+                cost = r.runs[i].work;
             }
             mesh_runs.push(i);
         }
@@ -474,7 +606,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
     // target needs); `offset` is the scene's mesh's index in `mesh_runs`
     let mut offset = 0;
     if let (Some(e), true) = (&mesh_estimate, mesh.is_some() && coarsenable(&base)) {
-        let cost = mesh_runs[0].map_or(0.0, |i| r.runs[i].seconds) / 2.0;
+        let cost = mesh_runs[0].map_or(0.0, |i| r.runs[i].work) / 2.0;
         if let Some(i) = r.run(Role::Mesh, at(mesh_level, -1), cost) {
             let share = r.values(i).map(|y| distance(y, &e.limit, &peaks));
             mesh_runs.insert(0, Some(i));
@@ -482,6 +614,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
             offset = 1;
         }
     }
+    r.forget();
     if has_mesh && opts.mesh_levels > 1 && mesh.is_none() {
         r.notes.push(
             "fewer than two meshes ran: the discretization error is not estimated (0)".into(),
@@ -494,9 +627,9 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
 
     // the choice: the cheapest (step, mesh) whose predicted error meets the target
     let cost_of = |k: usize, j: usize, r: &Runner| -> Option<f64> {
-        let c = r.runs[time_runs[k]?].seconds;
-        let m0 = r.runs[mesh_runs[offset]?].seconds;
-        let mj = r.runs[(*mesh_runs.get(j)?)?].seconds;
+        let c = r.runs[time_runs[k]?].work;
+        let m0 = r.runs[mesh_runs[offset]?].work;
+        let mj = r.runs[(*mesh_runs.get(j)?)?].work;
         Some(c * mj / m0.max(1e-9))
     };
     // a candidate's error, as a function of time: its time error (at the scene's mesh) plus
@@ -550,7 +683,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
     let order = |l: &Option<Ladder>, default| l.as_ref().map_or(default, |l| l.order);
     let p_time = order(&time, TIME_ORDER);
     let mut choice = None;
-    if let Some((k, j, ladder_predicted, ladder_seconds)) = best {
+    if let Some((k, j, ladder_predicted, ladder_work)) = best {
         let ladder_setting = at(k, j as i32 - offset as i32);
         // relaxed: the largest step up to the coarser rung (quarter octaves) that the time
         // ladder's order predicts to meet, at Newton's tolerance of the coarsest rung (the
@@ -565,19 +698,49 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
                 let d = distance(&e, &zero, &peaks);
                 (d * margin <= opts.target).then_some((s, d))
             });
-        let mut picked = (ladder_setting, 1.0, ladder_predicted, ladder_seconds);
+        let mut picked = (ladder_setting, 1.0, ladder_predicted, ladder_work);
+        let relaxed_of = |s: f64| Setting {
+            step: if s > 1.0 {
+                three_digits_down(ladder_setting.step * s)
+            } else {
+                ladder_setting.step
+            },
+            newton: tol0,
+            ..ladder_setting
+        };
+        // run ahead: the setting the relaxation probably keeps, its checks, and the time
+        // ladder of the re-centred study that may follow (its steps at the chosen mesh)
+        let likely = stretch.map_or(ladder_setting, |(s, _)| relaxed_of(s));
+        let mut ahead_runs = vec![likely];
+        ahead_runs.extend(
+            checks(likely, has_mesh)
+                .into_iter()
+                .take(2 + usize::from(has_mesh)),
+        );
+        if ahead {
+            let halved_error = (offset == 1)
+                .then(|| mesh_runs[0].and_then(|i| r.values(i)))
+                .flatten()
+                .map(|y| distance(y, &limit, &peaks));
+            if let Some(m) =
+                recentre_mesh(j as i32 - offset as i32, halved_error, margin, opts.target)
+            {
+                // as deep as this study's ladder went (the finest first: the longest)
+                ahead_runs.extend(
+                    (0..time_runs.len().max(opts.levels))
+                        .rev()
+                        .map(|k| Setting {
+                            mesh: m,
+                            ..at(k, 0)
+                        }),
+                );
+            }
+        }
+        r.speculate(&ahead_runs);
         if let Some((s, d)) = stretch {
-            let relaxed = Setting {
-                step: if s > 1.0 {
-                    three_digits_down(ladder_setting.step * s)
-                } else {
-                    ladder_setting.step
-                },
-                newton: tol0,
-                ..ladder_setting
-            };
+            let relaxed = relaxed_of(s);
             if relaxed != ladder_setting {
-                let seconds = ladder_seconds / s;
+                let seconds = ladder_work / s;
                 let kept = r.run(Role::Chosen, relaxed, seconds).and_then(|i| {
                     let e = distance(r.values(i)?, &limit, &peaks);
                     if e * margin <= opts.target {
@@ -600,20 +763,15 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
                 }
             }
         }
-        let (setting, s, predicted, predicted_seconds) = picked;
+        let (setting, s, predicted, predicted_work) = picked;
         let existing = r
             .runs
             .iter()
             .position(|x| x.setting == setting && x.result.is_ok());
-        let run = existing.or_else(|| r.run(Role::Chosen, setting, predicted_seconds));
+        let run = existing.or_else(|| r.run(Role::Chosen, setting, predicted_work));
         if let Some(run) = run.filter(|&i| r.values(i).is_some()) {
-            let finer_setting = Setting {
-                step: setting.step / 2.0,
-                newton: (setting.newton / NEWTON_PER_HALVING).max(1e-14),
-                mesh: setting.mesh + i32::from(has_mesh),
-                stiffening_switched: false,
-            };
-            let finer_cost = predicted_seconds * if has_mesh { 5.0 } else { 2.0 };
+            let [finer_setting, newton_setting, stiffening_setting] = checks(setting, has_mesh);
+            let finer_cost = predicted_work * if has_mesh { 5.0 } else { 2.0 };
             // a ladder's run at that setting serves (C4: the mesh ladder ran at the step above)
             let finer = r
                 .runs
@@ -628,31 +786,16 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
                     )
                 });
             let probe = |r: &mut Runner, role, s: Setting| -> Option<Result<f64, String>> {
-                let i = r.run(role, s, predicted_seconds * 1.5)?;
+                let i = r.run(role, s, predicted_work * 1.5)?;
                 let chosen = r.values(run)?;
                 Some(match &r.runs[i].result {
                     Ok(y) => Ok(distance(y, chosen, &peaks)),
                     Err(e) => Err(e.clone()),
                 })
             };
-            let newton_share = probe(
-                &mut r,
-                Role::Newton,
-                Setting {
-                    newton: (setting.newton / NEWTON_PROBE).max(1e-15),
-                    ..setting
-                },
-            )
-            .and_then(Result::ok);
+            let newton_share = probe(&mut r, Role::Newton, newton_setting).and_then(Result::ok);
             let stiffening_change = if has_mesh {
-                probe(
-                    &mut r,
-                    Role::Stiffening,
-                    Setting {
-                        stiffening_switched: true,
-                        ..setting
-                    },
-                )
+                probe(&mut r, Role::Stiffening, stiffening_setting)
             } else {
                 None
             };
@@ -676,7 +819,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
                 expected_difference,
                 time_share: time_shares[k].unwrap_or(0.0) * s.powf(p_time),
                 mesh_share: mesh_shares[j].unwrap_or(0.0),
-                predicted_seconds,
+                predicted_work,
                 run,
                 finer,
                 newton_share,
@@ -688,6 +831,9 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         }
     }
     r.bar.finish_and_clear();
+    if !ahead {
+        r.forget();
+    }
 
     // every run's estimated error against the limit
     for run in &mut r.runs {
@@ -696,6 +842,7 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         }
     }
     let cpu_seconds = r.runs.iter().map(|x| x.seconds).sum();
+    let work = r.work();
     let mut study = Study {
         scene: base.name.clone(),
         outputs: opts.outputs.clone(),
@@ -715,9 +862,13 @@ fn study_of(base: &Scene, opts: &Options) -> Result<Study, crate::HarnessError> 
         mesh_shares,
         choice,
         notes: r.notes,
+        work,
         cpu_seconds,
         wall_seconds: r.started.elapsed().as_secs_f64(),
         earlier_runs: 0,
+        incomplete: r.incomplete,
+        jobs: 1,
+        unused: (0, 0.0),
     };
     if let Some(reference) = &reference {
         truth::judge(&mut study, reference);

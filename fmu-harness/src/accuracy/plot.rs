@@ -1,4 +1,4 @@
-//! The study's work-precision chart as a PNG: estimated error against CPU seconds, log-log,
+//! The study's work-precision chart as a PNG: estimated error against counted work, log-log,
 //! one line per ladder, the target, the chosen setting and its finer check. Drawn with
 //! `embedded-graphics` (as the animations are) on the charts' [`Canvas`].
 
@@ -37,7 +37,7 @@ pub fn png(study: &Study) -> Vec<u8> {
         .runs
         .iter()
         .filter(|r| on_ladder(r))
-        .filter_map(|r| Some((r.seconds.max(1e-6), r.error()?.max(1e-16), r.role)))
+        .filter_map(|r| Some((r.work.max(1e-6), r.error()?.max(1e-16), r.role)))
         .collect();
     let (mut xlo, mut xhi, mut ylo, mut yhi) = (f64::MAX, 0.0_f64, study.target, study.target);
     for &(x, y, _) in &pts {
@@ -89,7 +89,7 @@ pub fn png(study: &Study) -> Vec<u8> {
         .into_styled(thin(INK))
         .draw(&mut c);
     let _ = Text::with_alignment(
-        "CPU seconds of a run",
+        "counted work of a run (about CPU s)",
         Point::new(ml + w / 2, HEIGHT as i32 - 12),
         text,
         Alignment::Center,
@@ -125,7 +125,7 @@ pub fn png(study: &Study) -> Vec<u8> {
                 .nth(study.mesh_step_level)
             {
                 if let Some(e) = r.error() {
-                    line.push(Point::new(px(r.seconds.max(1e-6)), py(e.max(1e-16))));
+                    line.push(Point::new(px(r.work.max(1e-6)), py(e.max(1e-16))));
                 }
             }
         }
@@ -147,7 +147,7 @@ pub fn png(study: &Study) -> Vec<u8> {
         let mut mark = |i: usize, col| {
             let r = &study.runs[i];
             if let Some(e) = r.error() {
-                let p = Point::new(px(r.seconds.max(1e-6)), py(e.max(1e-16)));
+                let p = Point::new(px(r.work.max(1e-6)), py(e.max(1e-16)));
                 let _ = Circle::with_center(p, 15)
                     .into_styled(PrimitiveStyle::with_stroke(col, 2))
                     .draw(&mut c);

@@ -2,8 +2,9 @@
 //! the scene's, or the halved mesh's own error leaves room for the step's, the whole study runs
 //! again with that mesh as the scene's, and the cheaper certified choice is kept.
 
+use super::pool::Pool;
 use super::runner::scene_at;
-use super::{study_of, Options, Role, Setting, Study};
+use super::{recentre_mesh, study_of, Options, Role, Setting, Study};
 use fmu_beam::Scene;
 
 /// The ladders measure the step's error at the scene's mesh and add each mesh's error at one
@@ -14,20 +15,28 @@ use fmu_beam::Scene;
 /// again with that mesh as the scene's, in what is left of the budget, and the cheaper of the
 /// two choices (each certified by its own ladders, finer run and factor) is kept, the other
 /// named in a note.
-pub(super) fn recentred(base: &Scene, opts: &Options, mut first: Study) -> Study {
+pub(super) fn recentred(
+    base: &Scene,
+    opts: &Options,
+    mut first: Study,
+    pool: &Pool,
+    interrupted: &dyn Fn() -> bool,
+) -> Study {
     let Some(c) = first.choice.as_ref() else {
         return first;
     };
+    if first.incomplete.is_some() {
+        return first;
+    }
     // the chosen mesh, else the halved one where its own error leaves room for the step's
-    let halved_fits = first.runs.iter().any(|r| {
-        r.role == Role::Mesh
-            && r.setting.mesh == -1
-            && r.error().is_some_and(|e| e * first.margin < first.target)
-    });
-    let m = match c.setting.mesh {
-        0 if halved_fits => -1,
-        0 => return first,
-        m => m,
+    let halved_error = first
+        .runs
+        .iter()
+        .find(|r| r.role == Role::Mesh && r.setting.mesh == -1)
+        .and_then(|r| r.error());
+    let Some(m) = recentre_mesh(c.setting.mesh, halved_error, first.margin, first.target) else {
+        pool.forget(&[]);
+        return first;
     };
     let at_mesh = Setting {
         step: base.solver.max_step,
@@ -41,41 +50,43 @@ pub(super) fn recentred(base: &Scene, opts: &Options, mut first: Study) -> Study
     moved.solver.adaptive = base.solver.adaptive;
     let mut o = opts.clone();
     o.max_runs = opts.max_runs.saturating_sub(first.runs.len());
-    o.max_seconds = opts.max_seconds - first.wall_seconds;
+    o.max_work = opts.max_work - first.work;
     let mesh = first.mesh_name(m).to_string();
-    let first_seconds = first.runs[c.run].seconds;
+    let first_work = first.runs[c.run].work;
     let said = |s: &Study| {
         s.choice.as_ref().map_or("no choice".to_string(), |c| {
             format!(
-                "h = {:e} s, mesh {}, estimated {:.2e}, {:.3} CPU s",
+                "h = {:e} s, mesh {}, estimated {:.2e}, work {:.3}",
                 c.setting.step,
                 s.mesh_name(c.setting.mesh),
                 c.predicted,
-                s.runs[c.run].seconds
+                s.runs[c.run].work
             )
         })
     };
-    let second = if o.max_runs == 0 || o.max_seconds <= 0.0 {
+    let second = if o.max_runs == 0 || o.max_work <= 0.0 {
         Err("the budget is spent".to_string())
     } else {
-        study_of(&moved, &o).map_err(|e| e.to_string())
+        study_of(&moved, &o, pool, interrupted, false).map_err(|e| e.to_string())
     };
     match second {
         Ok(mut second)
             if second
                 .choice
                 .as_ref()
-                .is_some_and(|c2| second.runs[c2.run].seconds < first_seconds) =>
+                .is_some_and(|c2| second.runs[c2.run].work < first_work)
+                && second.incomplete.is_none() =>
         {
             let note = format!(
-                "re-centred: the first study (at the scene's mesh, {} runs, {:.2} CPU s) chose \
-                 {}; this study, with {mesh} as the scene's mesh, chose a cheaper setting",
+                "re-centred: the first study (at the scene's mesh, {} runs, work {:.2}) chose {}; \
+                 this study, with {mesh} as the scene's mesh, chose a cheaper setting",
                 first.runs.len(),
-                first.cpu_seconds,
+                first.work,
                 said(&first)
             );
             second.notes.insert(0, note);
             second.earlier_runs = first.runs.len();
+            second.work += first.work;
             second.cpu_seconds += first.cpu_seconds;
             second.wall_seconds += first.wall_seconds;
             second
@@ -83,11 +94,21 @@ pub(super) fn recentred(base: &Scene, opts: &Options, mut first: Study) -> Study
         Ok(second) => {
             first.earlier_runs += second.runs.len();
             first.notes.push(format!(
-                "re-centred on {mesh} ({} runs, {:.2} CPU s): {}, not cheaper; kept",
+                "re-centred on {mesh} ({} runs, work {:.2}): {}{}; kept",
                 second.runs.len(),
-                second.cpu_seconds,
-                said(&second)
+                second.work,
+                said(&second),
+                if second.incomplete.is_some() {
+                    ", INCOMPLETE (its wall-clock safety stop fired)"
+                } else {
+                    ", not cheaper"
+                }
             ));
+            for n in second.notes.iter().filter(|n| n.contains("safety stop")) {
+                first.notes.push(n.clone());
+            }
+            first.incomplete = first.incomplete.take().or(second.incomplete);
+            first.work += second.work;
             first.cpu_seconds += second.cpu_seconds;
             first.wall_seconds += second.wall_seconds;
             first

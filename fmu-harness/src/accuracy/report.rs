@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 /// The work-precision table as CSV: one row per run.
 pub fn csv(study: &Study) -> String {
     let mut s = String::from(
-        "run,role,step_s,newton_tolerance,mesh,stiffening_switched,cpu_s,steps,status,estimated_error",
+        "run,role,step_s,newton_tolerance,mesh,stiffening_switched,steps,newton_iterations,jacobians,work,status,estimated_error",
     );
     for o in &study.outputs {
         let _ = write!(s, ",error_{o}");
@@ -16,7 +16,8 @@ pub fn csv(study: &Study) -> String {
     if study.judged() {
         s.push_str(",true_error");
     }
-    s.push('\n');
+    // the timing last: what differs between runs of the same study
+    s.push_str(",cpu_s\n");
     for (i, r) in study.runs.iter().enumerate() {
         let status = match &r.result {
             Ok(_) => "ok".to_string(),
@@ -24,15 +25,17 @@ pub fn csv(study: &Study) -> String {
         };
         let _ = write!(
             s,
-            "{},{},{:e},{:e},\"{}\",{},{:.6},{},{},{}",
+            "{},{},{:e},{:e},\"{}\",{},{},{},{},{:.6},{},{}",
             i + 1,
             r.role.name(),
             r.setting.step,
             r.setting.newton,
             mesh_of(study, r),
             r.setting.stiffening_switched,
-            r.seconds,
-            r.steps,
+            r.counts.steps,
+            r.counts.iterations,
+            r.counts.jacobians,
+            r.work,
             status,
             r.error().map_or(String::new(), |e| format!("{e:.4e}")),
         );
@@ -46,7 +49,7 @@ pub fn csv(study: &Study) -> String {
                 r.true_error().map_or(String::new(), |e| format!("{e:.4e}"))
             );
         }
-        s.push('\n');
+        let _ = writeln!(s, ",{:.6}", r.seconds);
     }
     s
 }
@@ -78,7 +81,7 @@ fn ladder_text(name: &str, l: &Option<Ladder>, nominal: f64) -> String {
 }
 
 /// Which share limits the error.
-fn limit_name(time: f64, mesh: f64, newton: f64) -> &'static str {
+pub fn limit_name(time: f64, mesh: f64, newton: f64) -> &'static str {
     if newton >= time && newton >= mesh {
         "Newton's tolerance"
     } else if time >= mesh {
@@ -118,7 +121,7 @@ pub fn markdown(study: &Study) -> String {
     );
     let _ = write!(
         s,
-        "| run | ladder | step (s) | Newton tol. | mesh | CPU s | steps | estimated error |"
+        "| run | ladder | step (s) | Newton tol. | mesh | work | CPU s | steps | Newton it. | estimated error |"
     );
     for o in &study.outputs {
         let _ = write!(s, " {o} |");
@@ -126,7 +129,7 @@ pub fn markdown(study: &Study) -> String {
     if study.judged() {
         s.push_str(" true error |");
     }
-    let _ = write!(s, "\n|---|---|---|---|---|---|---|---|");
+    let _ = write!(s, "\n|---|---|---|---|---|---|---|---|---|---|");
     for _ in &study.outputs {
         s.push_str("---|");
     }
@@ -147,13 +150,15 @@ pub fn markdown(study: &Study) -> String {
         };
         let _ = write!(
             s,
-            "| {} | {} | {:.3e} | {:.0e} | {mesh} | {:.3} | {} | {err} |",
+            "| {} | {} | {:.3e} | {:.0e} | {mesh} | {:.3} | {:.3} | {} | {} | {err} |",
             i + 1,
             r.role.name(),
             r.setting.step,
             r.setting.newton,
+            r.work,
             r.seconds,
-            r.steps
+            r.counts.steps,
+            r.counts.iterations
         );
         for e in &r.errors {
             let _ = write!(s, " {e:.2e} |");
@@ -196,7 +201,7 @@ pub fn markdown(study: &Study) -> String {
                  times {} meets the target (a safety factor: {}). A fixed step of {:e} s, Newton's tolerance \
                  {:.0e}, mesh {}: predicted error {:.2e} (its time error {:.2e} and mesh error {:.2e} \
                  added over time), \
-                 estimated from its run {est:.2e}, {:.3} CPU s (predicted {:.3}).\n\nIn the \
+                 estimated from its run {est:.2e}, work {:.3} (predicted {:.3}; {:.3} CPU s).\n\nIn the \
                  scene: `[solver] adaptive = false`, `max_step = {:e}`, `tolerance = {:.0e}`; \
                  beams: {}.\n",
                 study.target,
@@ -212,8 +217,9 @@ pub fn markdown(study: &Study) -> String {
                 c.predicted,
                 c.time_share,
                 c.mesh_share,
+                run.work,
+                c.predicted_work,
                 run.seconds,
-                c.predicted_seconds,
                 c.setting.step,
                 c.setting.newton,
                 mesh_of(study, run)
@@ -297,9 +303,13 @@ pub fn markdown(study: &Study) -> String {
             s.push('\n');
         }
     }
+    if let Some(why) = &study.incomplete {
+        let _ = writeln!(s, "## INCOMPLETE\n\n{why}.\n");
+    }
     let _ = writeln!(
         s,
-        "## Cost\n\n{} runs{}, {:.2} CPU s, {:.2} s wall.",
+        "## Cost\n\n{} runs{}, work {:.2} (counted: what the study ranks settings and keeps \
+         to its budget by), {:.2} CPU s, {:.2} s wall, {} run{} at once.",
         study.runs.len() + study.earlier_runs,
         if study.earlier_runs > 0 {
             format!(
@@ -309,13 +319,58 @@ pub fn markdown(study: &Study) -> String {
         } else {
             String::new()
         },
+        study.work,
         study.cpu_seconds,
-        study.wall_seconds
+        study.wall_seconds,
+        study.jobs,
+        if study.jobs == 1 { "" } else { "s" }
     );
+    if study.jobs > 1 {
+        let _ = writeln!(
+            s,
+            "- run ahead and not asked for: {} runs, {:.2} CPU s (not in the table)",
+            study.unused.0, study.unused.1
+        );
+    }
     for n in &study.notes {
         let _ = writeln!(s, "- {n}");
     }
     s
+}
+
+/// The study in a few numbers, as JSON (`study.json`, read by `fmu-bench exhaustive`): the
+/// target, the safety factor, whether it is complete, the choice (its setting, counted work,
+/// errors) and the study's own cost.
+pub fn json(study: &Study) -> String {
+    let choice = study.choice.as_ref().map(|c| {
+        let run = &study.runs[c.run];
+        serde_json::json!({
+            "step": c.setting.step,
+            "newton": c.setting.newton,
+            "mesh": study.mesh_name(c.setting.mesh),
+            "work": run.work,
+            "cpu_s": run.seconds,
+            "predicted_error": c.predicted,
+            "estimated_error": run.error(),
+            "true_error": run.true_error(),
+        })
+    });
+    let v = serde_json::json!({
+        "scene": study.scene,
+        "outputs": study.outputs,
+        "target": study.target,
+        "margin": study.margin,
+        "incomplete": study.incomplete,
+        "choice": choice,
+        "runs": study.runs.len() + study.earlier_runs,
+        "work": study.work,
+        "cpu_s": study.cpu_seconds,
+        "wall_s": study.wall_seconds,
+        "jobs": study.jobs,
+        "unused_runs": study.unused.0,
+        "unused_cpu_s": study.unused.1,
+    });
+    format!("{v:#}\n")
 }
 
 /// Whether a run is one of the ladders' (the chart's points).

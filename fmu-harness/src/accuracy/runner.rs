@@ -1,22 +1,13 @@
 //! One run of a study: the scene at a setting (fixed step, Newton's tolerance, mesh), run in
-//! process over the communication grid, timed, within the study's budget (runs, wall seconds)
-//! and drawn on the progress bar.
+//! process over the communication grid (by [`super::pool`]), counted and timed, within the
+//! study's budget (runs, counted work) and drawn on the progress bar.
 
+use super::cost::{Counts, Shape};
 use super::estimate::Series;
-use super::{Role, Run, Setting, COARSE_CPU};
-use fmu_beam::{Engine, Scene};
+use super::pool::{Failure, Job, Pool};
+use super::{Role, Run, Setting};
+use fmu_beam::Scene;
 use std::time::Instant;
-
-/// CPU seconds this thread has run (the scheduler's account), where Linux says.
-pub(super) fn thread_cpu_seconds() -> Option<f64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse::<f64>()
-        .ok()
-        .map(|ns| ns * 1e-9)
-}
 
 /// The flexible beams a mesh refinement doubles: not rigid, not from a matrix file.
 pub(super) fn refinable(b: &fmu_beam::scene::BeamSpec) -> bool {
@@ -92,62 +83,69 @@ pub(super) struct Grid<'a> {
     pub(super) n: usize,
 }
 
-/// Runs `scene` over the grid: the outputs at every point, the steps taken.
-pub(super) fn simulate(scene: Scene, grid: &Grid) -> Result<(Series, i64), String> {
-    let mut e = Engine::new(scene);
-    let vrs: Vec<u32> = grid
-        .outputs
-        .iter()
-        .map(|o| {
-            e.variables()
-                .by_name(o)
-                .map(|v| v.vr)
-                .ok_or_else(|| format!("the unit has no output {o}"))
-        })
-        .collect::<Result<_, _>>()?;
-    e.exit_initialization().map_err(|x| x.to_string())?;
-    let mut values = vec![Vec::with_capacity(grid.n + 1); vrs.len()];
-    for k in 0..=grid.n {
-        if k > 0 {
-            let t = grid.start + (k - 1) as f64 * grid.comm;
-            e.do_step(t, grid.comm)
-                .map_err(|x| format!("at t = {t} s: {x}"))?;
-        }
-        for (v, &vr) in values.iter_mut().zip(&vrs) {
-            v.push(e.get_real(vr).map_err(|x| x.to_string())?);
-        }
-    }
-    let steps = match e.variables().by_name("solver.steps").map(|v| v.vr) {
-        Some(vr) => i64::from(e.get_integer(vr).unwrap_or(0)),
-        None => 0,
-    };
-    Ok((values, steps))
-}
-
-/// The study's runner: its budget and its progress bar.
+/// The study's runner: its budget (counted), its progress bar, and the pool that runs (or has
+/// run ahead) what it asks for.
 pub(super) struct Runner<'a> {
     pub(super) base: &'a Scene,
     pub(super) grid: Grid<'a>,
     pub(super) runs: Vec<Run>,
     pub(super) started: Instant,
     pub(super) max_runs: usize,
-    pub(super) max_seconds: f64,
+    /// The counted budget ([`super::cost`]).
+    pub(super) max_work: f64,
     pub(super) notes: Vec<String>,
     pub(super) bar: indicatif::ProgressBar,
+    pub(super) pool: &'a Pool,
+    pub(super) interrupted: &'a dyn Fn() -> bool,
+    /// Why the study stopped before its end (the wall-clock safety stop, an interrupt).
+    pub(super) incomplete: Option<String>,
 }
 
 impl Runner<'_> {
-    /// Runs `setting` unless the budget would be passed (runs, or wall seconds with this run's
-    /// predicted cost); the run's index.
+    /// The counted work of the runs so far.
+    pub(super) fn work(&self) -> f64 {
+        self.runs.iter().map(|r| r.work).sum()
+    }
+
+    /// The job of `setting` on this study's grid.
+    pub(super) fn job(&self, setting: &Setting) -> Result<Job, String> {
+        Ok(Job {
+            scene: scene_at(self.base, setting)?,
+            outputs: self.grid.outputs.to_vec(),
+            start: self.grid.start,
+            comm: self.grid.comm,
+            n: self.grid.n,
+        })
+    }
+
+    /// Hands `settings` (first = soonest) to the pool's workers: the study will probably ask
+    /// for them next.
+    pub(super) fn speculate(&self, settings: &[Setting]) {
+        if self.pool.workers() > 0 && self.incomplete.is_none() {
+            self.pool
+                .speculate(settings.iter().filter_map(|s| self.job(s).ok()).collect());
+        }
+    }
+
+    /// Drops what was run ahead and not asked for: the study has gone past it.
+    pub(super) fn forget(&self) {
+        self.pool.forget(&[]);
+    }
+
+    /// Runs `setting` unless the budget would be passed (runs, or counted work with this
+    /// run's predicted work); the run's index. Nothing runs once the study was stopped.
     pub(super) fn run(&mut self, role: Role, setting: Setting, predicted: f64) -> Option<usize> {
-        let spent = self.started.elapsed().as_secs_f64();
-        if self.runs.len() >= self.max_runs || spent + predicted > self.max_seconds {
+        if self.incomplete.is_some() {
+            return None;
+        }
+        let spent = self.work();
+        if self.runs.len() >= self.max_runs || spent + predicted > self.max_work {
             self.notes.push(format!(
-                "not run ({} runs, {spent:.1} s spent, this one predicted {predicted:.2} s; \
-                 budget {} runs, {} s): {} run at h = {:e} s, {}",
+                "not run ({} runs, work {spent:.2} spent, this one predicted {predicted:.2}; \
+                 budget {} runs, work {}): {} run at h = {:e} s, {}",
                 self.runs.len(),
                 self.max_runs,
-                self.max_seconds,
+                self.max_work,
                 role.name(),
                 setting.step,
                 mesh_text(self.base, setting.mesh)
@@ -160,23 +158,42 @@ impl Runner<'_> {
             setting.step,
             mesh_text(self.base, setting.mesh)
         ));
-        let wall = Instant::now();
-        let cpu0 = thread_cpu_seconds();
-        let outcome = scene_at(self.base, &setting).and_then(|s| simulate(s, &self.grid));
-        let seconds = match (cpu0, thread_cpu_seconds()) {
-            (Some(a), Some(b)) if b - a >= COARSE_CPU => b - a,
-            _ => wall.elapsed().as_secs_f64(),
-        };
-        let (result, steps) = match outcome {
-            Ok((v, s)) => (Ok(v), s),
-            Err(e) => (Err(e), 0),
+        let (result, counts, work, seconds) = match self.job(&setting) {
+            Err(m) => (Err(m), Counts::default(), 0.0, 0.0),
+            Ok(job) => {
+                let shape = Shape::of(&job.scene);
+                let out = self.pool.take(job, self.interrupted);
+                match out.result {
+                    Ok((y, c)) => (Ok(y), c, shape.work(&c), out.seconds),
+                    Err(Failure::Failed(m)) => (Err(m), Counts::default(), 0.0, out.seconds),
+                    Err(Failure::Stopped) => {
+                        let why = if self.pool.stop.load(std::sync::atomic::Ordering::Relaxed) {
+                            "interrupted".to_string()
+                        } else {
+                            format!(
+                                "the wall-clock safety stop ({:.0} s) fired during the {} run at \
+                                 h = {:e} s, {}: the study is INCOMPLETE, its choice is that of \
+                                 the runs before it",
+                                self.pool.limit_seconds(),
+                                role.name(),
+                                setting.step,
+                                mesh_text(self.base, setting.mesh)
+                            )
+                        };
+                        self.notes.push(why.clone());
+                        self.incomplete = Some(why);
+                        return None;
+                    }
+                }
+            }
         };
         self.runs.push(Run {
             role,
             setting,
             result,
             seconds,
-            steps,
+            counts,
+            work,
             errors: Vec::new(),
             true_errors: Vec::new(),
         });

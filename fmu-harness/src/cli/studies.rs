@@ -47,9 +47,19 @@ pub struct AccuracyArgs {
     /// The study's budget: runs (both studies, where it is re-centred).
     #[arg(long, default_value_t = 60)]
     pub max_runs: usize,
-    /// The study's budget: wall seconds (a run predicted to pass it is left out and said).
-    #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+    /// The study's budget: counted work (steps, Newton iterations and iteration matrices
+    /// weighed by the system's size; about a CPU second a unit where fitted). A run predicted
+    /// to pass it is left out and said; the same on any machine and under any load.
+    #[arg(long, default_value_t = accuracy::DEFAULT_MAX_WORK, allow_hyphen_values = true)]
+    pub max_work: f64,
+    /// A safety stop in wall seconds: where it fires, the study stops and its report says
+    /// INCOMPLETE (its choice is then that of the runs before the stop).
+    #[arg(long, default_value_t = accuracy::DEFAULT_MAX_SECONDS, allow_hyphen_values = true)]
     pub max_seconds: f64,
+    /// Runs run at once [default: every core]. Runs the study will probably ask for next are
+    /// run ahead; the choice and the table are those of --jobs 1, but for the seconds.
+    #[arg(long)]
+    pub jobs: Option<usize>,
     /// A reference CSV (time first, on the study's grid; e.g. bench/reference/c4_omega10.csv):
     /// each run's true error is reported beside its estimate.
     #[arg(long, requires = "columns")]
@@ -85,23 +95,24 @@ pub(super) fn accuracy_cmd(args: AccuracyArgs, out: &mut dyn Write) -> Result<()
     o.levels = args.levels;
     o.mesh_levels = args.mesh_levels;
     o.max_runs = args.max_runs;
+    o.max_work = args.max_work;
     o.max_seconds = args.max_seconds;
+    o.jobs = args.jobs;
     o.reference = args.reference.map(|p| (p, args.columns));
     o.progress = true;
     o.recentre = !args.no_recentre;
-    // the files it writes are looked at before the study (the default folder is named after
-    // the scene, known once it is loaded)
-    let named = |dir: &Path| ["accuracy.csv", "accuracy.png", "chosen.toml"].map(|f| dir.join(f));
-    let scene_name =
-        || -> Result<String, HarnessError> { Ok(fmu_beam::Scene::load(&args.scene)?.name) };
-    let dir = match args.dir {
-        Some(d) => d,
-        None => Path::new("build/accuracy").join(scene_name()?),
-    };
-    let [csv, png, chosen] = named(&dir);
-    crate::output_file::check_all([csv.as_path(), &png, &chosen])?;
-    let study = accuracy::study(&args.scene, &o)?;
+    o.check()?;
+    let scene = fmu_beam::Scene::load(&args.scene)?;
+    // the files it writes are looked at before the study
+    let dir = args
+        .dir
+        .unwrap_or_else(|| Path::new("build/accuracy").join(&scene.name));
+    let [csv, json, png, chosen] =
+        ["accuracy.csv", "study.json", "accuracy.png", "chosen.toml"].map(|f| dir.join(f));
+    crate::output_file::check_all([csv.as_path(), &json, &png, &chosen])?;
+    let study = accuracy::study(&scene, &o)?;
     crate::output_file::write_atomically(&csv, accuracy::report::csv(&study).as_bytes())?;
+    crate::output_file::write_atomically(&json, accuracy::report::json(&study).as_bytes())?;
     crate::output_file::write_atomically(&png, &accuracy::plot::png(&study))?;
     let mut wrote = format!("{} and {}", csv.display(), png.display());
     if let Some(c) = &study.choice {
