@@ -184,6 +184,9 @@ demo: .venv fmus
 # pytest runs in two processes side by side: tests/test_no_leaks.py (1e4 cycles under
 # valgrind, 3.5 min on one core; its own --basetemp, its output after the rest's) and the rest
 # (3 min): 3.4 min in all, where one after the other took 7.2 in the last CI (2026-11-29).
+# The fuzz stage runs last, shorter than `make fuzz` alone (issue 45 item 9: a couple of minutes).
+TEST_FUZZ_SECONDS        ?= 60
+TEST_FUZZ_PYTHON_SECONDS ?= 30
 test: .venv tools browser win64-tools
 	@mkdir -p build/win64; \
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
@@ -201,7 +204,9 @@ test: .venv tools browser win64-tools
 	WIN64=$(WIN64) $(PY) -m pytest tests -q --ignore=tests/test_no_leaks.py; rest=$$?; \
 	wait $$leaks; leaked=$$?; \
 	echo "pytest tests/test_no_leaks.py:"; cat build/pytest-leaks.log; \
-	exit $$(( rest || leaked ))
+	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS); fuzzed=$$?; \
+	$(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS); pyfuzzed=$$?; \
+	exit $$(( rest || leaked || fuzzed || pyfuzzed ))
 
 check:
 	cargo fmt --all --check
