@@ -7,6 +7,9 @@
    with 1 and 2 local processes, and on a Dask LocalCluster of 1 and 2 worker processes (one
    thread each): wall seconds, SWEEP_ROUNDS rounds each, interleaved.
 3. What a task ships and returns: pickled bytes of a task and of its reduced and unreduced result.
+4. The speedup of a Campbell diagram (the blade, 41 speeds, 6 modes) on 1 and 2 threads
+   (`Scene.campbell(jobs=)`): wall seconds, SWEEP_ROUNDS rounds each, interleaved. (C2's accuracy
+   study on 1 and 2 threads takes 3 min a run: docs/accuracy.md has it, `fmu-beam accuracy --jobs`.)
 
 Writes build/bench/STUDIES.md and studies.json; prints the tables. Figures are min / median / max
 over the rounds, with the load average before and after.
@@ -129,6 +132,25 @@ def payload():
             "series_result_bytes": len(series)}
 
 
+def campbell_speedup():
+    import fmu_beam
+
+    scene = fmu_beam.Scene.load(ROOT / "examples" / "blade_droop" / "blade.toml")
+    speeds = [0.5 * i for i in range(41)]
+    walls = {1: [], 2: []}
+    reference = None
+    for k in range(SWEEP_ROUNDS):
+        for jobs in ((1, 2) if k % 2 == 0 else (2, 1)):
+            t = time.perf_counter()
+            df = scene.campbell(speeds, count=6, jobs=jobs)
+            walls[jobs].append(time.perf_counter() - t)
+            if reference is None:
+                reference = df
+            assert df.equals(reference), f"jobs={jobs}: the diagram differs from the first run's"
+            print(f"round {k + 1}: campbell jobs={jobs}: {walls[jobs][-1]:.2f} s", flush=True)
+    return walls, statistics.median(walls[1]) / statistics.median(walls[2])
+
+
 def main():
     OUT.mkdir(parents=True, exist_ok=True)
     before = load()
@@ -136,6 +158,7 @@ def main():
     overhead = simulate_overhead()
     walls, speed, _ = sweep_speedup()
     sizes = payload()
+    campbell_walls, campbell_speed = campbell_speedup()
     after = load()
     lines = [
         "# Python studies: what they cost",
@@ -166,6 +189,15 @@ def main():
         f"| Dask LocalCluster, 1 thread a worker | {spread(walls['dask 1'])} | {spread(walls['dask 2'])} | "
         f"{speed['dask']:.2f} |",
         "",
+        "## A Campbell diagram on 1 and 2 threads",
+        "",
+        f"examples/blade_droop/blade.toml, 41 speeds from 0 to 20 rad/s, 6 modes (`Scene.campbell(jobs=)`); wall "
+        f"seconds, {SWEEP_ROUNDS} rounds interleaved (min / median / max). Every diagram equals the first.",
+        "",
+        "| 1 thread (s) | 2 threads (s) | speedup (medians) |",
+        "|---|---|---|",
+        f"| {spread(campbell_walls[1])} | {spread(campbell_walls[2])} | {campbell_speed:.2f} |",
+        "",
         "## What a task ships",
         "",
         f"A task: {sizes['task_bytes']} bytes pickled (the scene's text {sizes['scene_text_bytes']} bytes, the "
@@ -175,7 +207,8 @@ def main():
     text = "\n".join(lines) + "\n"
     (OUT / "STUDIES.md").write_text(text)
     (OUT / "studies.json").write_text(json.dumps({"overhead": overhead, "walls": walls, "speedup": speed,
-                                                  "sizes": sizes, "load": [before, after]}, indent=1))
+                                                  "sizes": sizes, "campbell": {"walls": campbell_walls, "speedup": campbell_speed},
+                                                  "load": [before, after]}, indent=1))
     print(text)
 
 
