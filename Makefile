@@ -201,11 +201,11 @@ test: .venv tools browser win64-tools
 	$(PY) -m pytest tests/test_no_leaks.py -q -p no:cacheprovider --basetemp=build/pytest-leaks \
 	  >build/pytest-leaks.log 2>&1 & leaks=$$!; \
 	echo "pytest: tests/test_no_leaks.py in the background (build/pytest-leaks.log)"; \
-	WIN64=$(WIN64) $(PY) -m pytest tests -q --ignore=tests/test_no_leaks.py; rest=$$?; \
-	wait $$leaks; leaked=$$?; \
+	rest=0; WIN64=$(WIN64) $(PY) -m pytest tests -q --ignore=tests/test_no_leaks.py || rest=$$?; \
+	leaked=0; wait $$leaks || leaked=$$?; \
 	echo "pytest tests/test_no_leaks.py:"; cat build/pytest-leaks.log; \
-	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS); fuzzed=$$?; \
-	$(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS); pyfuzzed=$$?; \
+	fuzzed=0; $(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS) || fuzzed=$$?; \
+	pyfuzzed=0; $(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS) || pyfuzzed=$$?; \
 	exit $$(( rest || leaked || fuzzed || pyfuzzed ))
 
 check:

@@ -62,6 +62,13 @@ def venv(wheel, tmp_path_factory):
     )
     measured(pip_install_s=round(time.perf_counter() - started, 2),
              wheel=wheel.name, wheel_bytes=wheel.stat().st_size)
+    # then what the wheel declares it needs (numpy, pandas: Scene.modes, simulate, sweep), as a
+    # user's `pip install` brings it (from pip's cache where .venv already fetched it)
+    subprocess.run(
+        [sys.executable, "-m", "pip", "--python", str(root / "bin" / "python"), "install",
+         "--quiet", str(wheel)],
+        check=True,
+    )
     env = {k: v for k, v in os.environ.items() if not k.startswith(("CARGO", "RUSTUP", "PYTHON"))}
     env["PATH"] = str(root / "bin")
     site = next((root / "lib").glob("python3*/site-packages"))
