@@ -14,7 +14,6 @@ mod tests {
             names,
             [
                 "logEvents",
-                "logInformation",
                 "logStatusWarning",
                 "logStatusDiscard",
                 "logStatusError",
