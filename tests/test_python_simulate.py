@@ -262,3 +262,12 @@ def test_a_scene_pickles_as_its_text():
     back = pickle.loads(pickle.dumps(s))
     assert back == s
     assert len(pickle.dumps(s)) < 64_000
+
+
+def test_information_goes_to_notes_and_warnings_to_messages():
+    # issue 46: slider_crank's fixed step cut to land on its torque's cut-off at 0.7 s is
+    # information (logging.info, attrs["notes"]), not a warning (attrs["messages"])
+    df = scene("slider_crank").simulate()
+    assert df.attrs["messages"] == []
+    (note,) = df.attrs["notes"]
+    assert "to land on a jump of a drive law" in note and "t = 0.7 s" in note

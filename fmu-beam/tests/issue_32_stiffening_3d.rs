@@ -131,7 +131,7 @@ fn rotor_blade_single_frame_with_stiffening_droops_as_converged_substructures() 
     assert!((plain - converged).abs() > 0.3 * converged.abs());
 }
 
-/// C4 at Ω = 10 (`spin_up_omega10_stiffened.toml`: one frame of 10 elements, stiffening) as a
+/// C4 at Ω = 10 (`spin_up_omega10_stiffened.toml`: one pinned frame of 10 elements, stiffening) as a
 /// 3D scene: the same beam in the world x–y plane, hub axis z, the in-plane second moment
 /// I_z = J (I_y = J, J_t = 2J, G = E/2.6 do not enter a planar motion); `formulation =
 /// "spatial"` makes it run with the 3D element, which would otherwise reduce it to the plane.
@@ -150,7 +150,7 @@ rho_inf = 0.9
 name = "beam"
 length = 8.0
 elements = 10
-frame = "tangent"
+frame = "pinned"
 material = { rho = 2767.0, E = 6.895e10, G = 2.652e10 }
 section = { A = 7.299e-5, Iy = 8.214e-9, Iz = 8.214e-9, It = 1.6428e-8 }
 geometric_stiffening = true

@@ -14,6 +14,7 @@ mod tests {
             names,
             [
                 "logEvents",
+                "logInformation",
                 "logStatusWarning",
                 "logStatusDiscard",
                 "logStatusError",

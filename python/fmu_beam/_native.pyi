@@ -235,6 +235,8 @@ class Unit:
         """The last accepted communication point (s)."""
     def messages(self) -> List[str]:
         """The warnings logged since the last call."""
+    def notes(self) -> List[str]:
+        """The information logged since the last call (a split step, an input's inertia)."""
     def units(self, names: Sequence[str]) -> Dict[str, Optional[str]]:
         """The unit of each name (None: dimensionless)."""
 

@@ -171,8 +171,9 @@ def simulate(
 ):
     """Runs the scene in process with its unit's engine and returns a pandas DataFrame indexed
     by time (s), one column per output; ``df.attrs["units"]`` maps each column to its unit
-    (None: dimensionless), ``df.attrs["messages"]`` holds what the unit logged (also sent to the
-    ``logging`` logger ``fmu_beam``).
+    (None: dimensionless), ``df.attrs["messages"]`` holds the warnings the unit logged and
+    ``df.attrs["notes"]`` its information (a split step...; both also sent to the ``logging``
+    logger ``fmu_beam``, as warnings and as info).
 
     - ``stop_time``, ``step_size`` (the communication step), ``start_time``: default the
       scene's ``[experiment]``.
@@ -248,6 +249,7 @@ def simulate(
     column_of = {n: i for i, n in enumerate(order)}
     rows: List[list] = []
     messages: List[str] = []
+    notes: List[str] = []
 
     def sample(time: float) -> list:
         row = [time]
@@ -261,6 +263,9 @@ def simulate(
         for m in unit.messages():
             messages.append(m)
             LOG.warning("%s: %s", scene.name, m)
+        for m in unit.notes():
+            notes.append(m)
+            LOG.info("%s: %s", scene.name, m)
 
     def frame():
         values = np.asarray([r[1:] for r in rows], dtype=np.float64).reshape(len(rows), len(order))
@@ -270,6 +275,7 @@ def simulate(
             df[n] = values[:, column_of[n]].astype(dtype)
         df.attrs["units"] = dict(unit.units(names))
         df.attrs["messages"] = list(messages)
+        df.attrs["notes"] = list(notes)
         df.attrs["scene"] = scene.name
         return df
 

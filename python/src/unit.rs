@@ -238,6 +238,12 @@ impl PyUnit {
         Ok(self.engine()?.take_messages())
     }
 
+    /// The information the unit logged since the last call (what an FMU logs with fmi2OK in
+    /// category logInformation: a split step, an input's effective inertia).
+    fn notes(&self) -> PyResult<Vec<String>> {
+        Ok(self.engine()?.take_notes())
+    }
+
     /// The units of the variables `names` (None: dimensionless), as a dict.
     fn units<'py>(&self, py: Python<'py>, names: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);

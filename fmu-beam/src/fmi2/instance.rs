@@ -219,6 +219,9 @@ impl Instance {
         for message in self.engine.take_messages() {
             self.logger.status(fmi2Status::fmi2Warning, &message);
         }
+        for note in self.engine.take_notes() {
+            self.logger.info(&note);
+        }
         result.map_err(|e| self.fail(e))?;
         if let Some(report) = self.tolerance_report() {
             self.logger.event(&report);
@@ -307,6 +310,9 @@ impl Instance {
         let result = self.engine.do_step(t, h);
         for message in self.engine.take_messages() {
             self.logger.status(fmi2Status::fmi2Warning, &message);
+        }
+        for note in self.engine.take_notes() {
+            self.logger.info(&note);
         }
         match result {
             Ok(()) => {

@@ -3,7 +3,9 @@
 //!
 //! Messages of a failed call (status Warning, Discard, Error, Fatal) are always sent, whatever
 //! fmi2SetDebugLogging said: the standard allows it and the master filters by category.
-//! Debug messages (category `logEvents`) are sent only when that category is switched on.
+//! Debug messages (category `logEvents`) and information (category `logInformation`, status
+//! fmi2OK: what the unit did on its own that asks nothing of the user) are sent only when their
+//! category is switched on (fmi2Instantiate's loggingOn, or fmi2SetDebugLogging).
 
 use super::types::{
     fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status,
@@ -16,6 +18,12 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     (
         "logEvents",
         "Changes of the instance's state: initialization, termination, reset, FMU state restored",
+    ),
+    (
+        "logInformation",
+        "What the unit did or found on its own that asks nothing of the user (status fmi2OK): \
+         a fixed step cut short (solver.split_steps counts them), the effective inertia of an \
+         input and the gains a sampled loop on it must keep",
     ),
     (
         "logStatusWarning",
@@ -34,6 +42,7 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
 ];
 
 const LOG_EVENTS: u32 = 1 << 0;
+const LOG_INFORMATION: u32 = 1 << 1;
 const ALL: u32 = (1 << LOG_CATEGORIES.len()) - 1;
 
 /// Where messages of one instance go, and which debug categories are on.
@@ -65,6 +74,13 @@ impl Logger {
     pub fn event(&self, message: &str) {
         if self.enabled & LOG_EVENTS != 0 {
             self.send(fmi2Status::fmi2OK, c"logEvents", message);
+        }
+    }
+
+    /// Information (category `logInformation`, status fmi2OK), sent only when that category is on.
+    pub fn info(&self, message: &str) {
+        if self.enabled & LOG_INFORMATION != 0 {
+            self.send(fmi2Status::fmi2OK, c"logInformation", message);
         }
     }
 
@@ -161,5 +177,8 @@ mod tests {
         assert_eq!(l.enabled, ALL & !LOG_EVENTS);
         l.set_debug_logging(false, &[]).unwrap();
         assert_eq!(l.enabled, 0);
+        l.set_debug_logging(true, &["logInformation".into()])
+            .unwrap();
+        assert_eq!(l.enabled, LOG_INFORMATION);
     }
 }

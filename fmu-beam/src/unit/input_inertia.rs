@@ -78,8 +78,8 @@ impl InputInertia {
         self.direction.iter().map(|&(k, x)| x * v[k]).sum()
     }
 
-    /// The warning at initialization of an input on a small effective inertia.
-    pub fn warning(&self, h: f64) -> String {
+    /// What initialization says of an input on a small effective inertia (information).
+    pub fn note(&self, h: f64) -> String {
         let (ju, eu, su) = self.units();
         let j = self.effective;
         format!(

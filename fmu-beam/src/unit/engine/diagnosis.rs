@@ -286,14 +286,16 @@ fn rotation(a: &Vector3<f64>, b: &Vector3<f64>) -> Vector3<f64> {
     axis * (s.atan2(a.dot(b)) / s)
 }
 
-/// Keeps the warnings of the effective inertias for the initialization (`Engine::built`).
-pub(super) fn inertia_warnings(
+/// What initialization says of each drive input on a small effective inertia (`Engine::built`):
+/// information (the limits a sampled loop on it must keep), logged with fmi2OK; a loop that
+/// breaks them is named in the failed step's message (cause (a)).
+pub(super) fn inertia_notes(
     inertias: &[crate::unit::input_inertia::InputInertia],
     h: f64,
 ) -> Vec<String> {
     inertias
         .iter()
         .filter(|i| i.is_small())
-        .map(|i| i.warning(h))
+        .map(|i| i.note(h))
         .collect()
 }

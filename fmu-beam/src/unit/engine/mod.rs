@@ -110,8 +110,12 @@ pub struct Engine {
     warned: Vec<bool>,
     /// Reasons for cutting a fixed step already logged.
     split_reported: Vec<SplitReason>,
-    /// Log messages (warnings) for the master, taken by the FMI layer.
+    /// Warnings for the master's log (something to act on: results may be off), taken by the
+    /// FMI layer and logged with fmi2Warning.
     messages: Vec<String>,
+    /// Information for the master's log (what the unit did or found on its own that asks
+    /// nothing of the user: a fixed step cut to land on a jump), logged with fmi2OK.
+    notes: Vec<String>,
     /// Whether what assembly moved was logged already (a restored state builds again).
     assembly_reported: bool,
     /// The effective inertia of each force or torque input, measured when the model was first
@@ -153,6 +157,7 @@ impl Engine {
             warned: vec![false; scene.beams.len()],
             split_reported: Vec::new(),
             messages: Vec::new(),
+            notes: Vec::new(),
             assembly_reported: false,
             inertias: None,
             probes: [None, None],
@@ -225,6 +230,12 @@ impl Engine {
     /// Log messages (warnings) collected since the last call.
     pub fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    /// Information collected since the last call: what the unit changed or found on its own
+    /// that asks nothing of the user (a split step, an input's effective inertia).
+    pub fn take_notes(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.notes)
     }
 
     /// Copies the input values and derivatives into the system, held from time t0. An input
@@ -457,8 +468,7 @@ impl Engine {
                 let inertias =
                     crate::unit::input_inertia::input_inertias(&system, &state, &self.table);
                 let h = scene.experiment.step_size;
-                self.messages
-                    .extend(diagnosis::inertia_warnings(&inertias, h));
+                self.notes.extend(diagnosis::inertia_notes(&inertias, h));
                 self.inertias = Some(inertias);
             }
             // what was recorded past the state restored is not this run's
@@ -582,7 +592,7 @@ impl Engine {
             return;
         }
         self.split_reported.push(why);
-        self.messages.push(format!(
+        self.notes.push(format!(
             "fixed step of {:.6e} s cut to {h:.6e} s at t = {t} s {}; solver.split_steps counts \
              every such step (this message is given once per reason)",
             m.stepper.settings.max_step,

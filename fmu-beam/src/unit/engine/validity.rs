@@ -126,8 +126,9 @@ fn check_beam<'a>(
                 "beam '{beam}': deflection {defl:.3e} m of frame '{frame}' at t = {t} s is \
                  {:.1} % of the frame's length, beyond the small-deformation range of a \
                  floating frame: more substructures extend it (for a spinning beam, or \
-                 geometric_stiffening); where an input acts on a small effective inertia (a \
-                 warning at initialization), a sampled loop on it grows the deflection",
+                 geometric_stiffening); where an input acts on a small effective inertia (said \
+                 at initialization, log category logInformation), a sampled loop on it grows \
+                 the deflection",
                 100.0 * defl / length
             ));
         }
