@@ -3,8 +3,12 @@ without a message of status fmi2Warning or worse (fmpy prints those on every run
 checker fails them). What is only information still reaches the log when logging is on: at
 status fmi2OK, in the category logInformation that modelDescription.xml declares."""
 
+from ctypes import byref
+
 import pytest
 from fmpy import read_model_description, simulate_fmu
+from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, printLogMessage
+from fmpy.logging import addLoggerProxy
 
 from conftest import packaged_fmus
 from fmu_util import ROOT
@@ -39,8 +43,26 @@ def run_logged(path, logging_on):
     def logger(env, instance_name, status, category, message):
         log.append((status, category.decode(), message.decode()))
 
-    result = simulate_fmu(str(path), debug_logging=logging_on, logger=logger)
+    try:
+        result = simulate_fmu(str(path), debug_logging=logging_on, logger=logger)
+    finally:
+        _restore_fmpy_logger_proxy()
     return result, log
+
+
+# fmpy's native logger proxy (fmpy/logging's logMessage) forwards to one process-wide logger, the
+# one of the last addLoggerProxy call: simulate_fmu(logger=...) leaves it pointing at a callback
+# freed on return, and every later FMU2Slave on fmpy's default callbacks then logs through a
+# dangling pointer (a segfault in tests/test_parameters.py's refused fmi2SetReal). After each run
+# it points again at a callback that lives as long as the process. (addLoggerProxy also replaces
+# the struct's logger by the proxy itself, so each call gets a fresh struct.)
+_LASTING = fmi2CallbackLoggerTYPE(printLogMessage)
+
+
+def _restore_fmpy_logger_proxy():
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = _LASTING
+    addLoggerProxy(byref(callbacks))
 
 
 def test_every_shipped_scene_is_packaged(fmu_dir):
