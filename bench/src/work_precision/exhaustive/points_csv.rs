@@ -3,8 +3,8 @@
 
 use super::{Point, CASES};
 use crate::error::BenchError;
-use std::fmt::Write as _;
 use fmu_harness::accuracy::cost::{Counts, Shape};
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// The points as CSV.
