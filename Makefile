@@ -40,7 +40,7 @@ WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/de
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
  \`make win64-tools\` installs them, as root): the FMUs carry binaries/linux64 only" >&2
 
-.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies bench-exhaustive example-split example-hinge example-arm example-sweep example-droop clean distclean
+.PHONY: .venv tools browser win64-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies bench-exhaustive bench-scaling example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes.
 .venv: $(STAMP)
@@ -290,6 +290,15 @@ bench-exhaustive: release
 	mkdir -p build/bench
 	nice $(BENCH) exhaustive --scenes scenes --references bench/reference --output build/bench \
 	  --studies build/accuracy $(if $(EXHAUSTIVE_POINTS),--points $(EXHAUSTIVE_POINTS))
+
+# How the engine's cost grows with the model (issue 46 item 3): C2's pendulum as n substructures
+# of one element and as one frame of n elements, n = 4 ... 128; set-up (Engine::new to
+# exit_initialization) and CPU time per step at a fixed step 1e-3 s, with Newton iterations and
+# iteration matrices, medians of 5 rounds and the exponents fitted on log-log
+# (fmu-bench scaling); build/bench/SCALING.md, the table of docs/accuracy.md. About 2 min.
+bench-scaling: release
+	mkdir -p build/bench
+	nice $(BENCH) scaling --scenes scenes --output build/bench
 
 # The accuracy study's choice against the peer bench's cheapest setting (issue 34 item 2: at
 # most 1.5x): after `make bench-accuracy` and `make bench-peer` (build/bench/ours_points.csv),

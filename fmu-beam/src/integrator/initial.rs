@@ -4,7 +4,7 @@
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
 use super::{GaState, Settings};
 use crate::error::EngineError;
-use crate::mechanics::multibody::{Equations, Point};
+use crate::mechanics::multibody::{Equations, JacobianRows, Point};
 use nalgebra::{DMatrix, DVector};
 
 const ASSEMBLY_ITERATIONS: usize = 50;
@@ -31,11 +31,11 @@ pub fn initial_state_from<S: Equations + ?Sized>(
     let (n, m) = (sys.n(), sys.m());
     let tol = 1e-12 * sys.length_scale().max(1.0);
     let mut g = DVector::zeros(m);
-    let mut gm = DMatrix::zeros(m, n);
     if m > 0 {
-        sys.constraint_jacobian(&q, t0, &mut gm);
-        check_rank(sys, &gm, t0)?;
+        check_rank(sys, &q, t0)?;
         let frames = sys.frame_coordinates();
+        // dense only if the bodies' own placement does not meet the joints (O(m n))
+        let mut gm = DMatrix::zeros(0, 0);
         let mut iterations = 0;
         let mut last_residual = f64::INFINITY;
         loop {
@@ -53,6 +53,9 @@ pub fn initial_state_from<S: Equations + ?Sized>(
                     tolerance: tol,
                     iterations,
                 });
+            }
+            if gm.shape() != (m, n) {
+                gm = DMatrix::zeros(m, n);
             }
             sys.constraint_jacobian(&q, t0, &mut gm);
             // Gauss–Newton on the frame coordinates only: assembling a mechanism places its
@@ -103,13 +106,84 @@ pub fn initial_state_from<S: Equations + ?Sized>(
     })
 }
 
-/// Refuses redundant joints: G must have full row rank.
-fn check_rank<S: Equations + ?Sized>(
-    sys: &S,
-    gm: &DMatrix<f64>,
-    t: f64,
-) -> Result<(), EngineError> {
-    check_rows_rank(sys, gm, &(0..gm.nrows()).collect::<Vec<_>>(), t)
+/// Refuses redundant joints: G must have full row rank. Proven cheaply where it can be
+/// ([`peels_to_full_rank`], linear in the bodies); otherwise the SVD of the dense G decides and
+/// names the joints.
+fn check_rank<S: Equations + ?Sized>(sys: &S, q: &DVector<f64>, t: f64) -> Result<(), EngineError> {
+    let mut rows = sys.jacobian_pattern();
+    sys.jacobian_rows(q, t, &mut rows);
+    if peels_to_full_rank(&sys.body_ranges(), &sys.row_bodies(), &rows) {
+        return Ok(());
+    }
+    let mut gm = DMatrix::zeros(sys.m(), sys.n());
+    rows.to_dense(&mut gm);
+    check_rows_rank(sys, &gm, &(0..gm.nrows()).collect::<Vec<_>>(), t)
+}
+
+/// How far above round-off (relative to ‖G‖_F) the smallest singular value of each peeled
+/// block must lie for [`peels_to_full_rank`] to call G full rank: far above the SVD's 1e-10, so
+/// that near-redundant joints go to the SVD.
+const PEEL_MARGIN: f64 = 1e-6;
+
+/// True when G has full row rank by peeling: the rows that still touch a body, restricted to that
+/// body's columns, with full row rank (the smallest singular value above [`PEEL_MARGIN`] ‖G‖_F)
+/// are independent of every other row (no other row has an entry there), so they are set aside,
+/// body after body, until none is left. A chain or tree of bodies peels from its leaves, in
+/// small SVDs of one body's rows; a loop that does not peel, or a block near rank deficiency,
+/// gives false and the dense SVD decides.
+fn peels_to_full_rank(
+    ranges: &[std::ops::Range<usize>],
+    row_bodies: &[[Option<usize>; 2]],
+    rows: &JacobianRows,
+) -> bool {
+    let m = row_bodies.len();
+    let norm = rows.values().iter().map(|x| x * x).sum::<f64>().sqrt();
+    let mut of_body: Vec<Vec<usize>> = vec![Vec::new(); ranges.len()];
+    for (row, bodies) in row_bodies.iter().enumerate() {
+        let mut b: Vec<usize> = bodies.iter().flatten().copied().collect();
+        b.dedup();
+        if b.is_empty() {
+            // a row on the world alone: zero, or a constant, never a rank
+            return false;
+        }
+        for body in b {
+            of_body[body].push(row);
+        }
+    }
+    let mut left = vec![true; m];
+    let mut remaining = m;
+    let mut queue: Vec<usize> = (0..ranges.len()).rev().collect();
+    let mut queued = vec![true; ranges.len()];
+    while let Some(b) = queue.pop() {
+        queued[b] = false;
+        let live: Vec<usize> = of_body[b].iter().copied().filter(|&r| left[r]).collect();
+        let cols = &ranges[b];
+        if live.is_empty() || live.len() > cols.len() {
+            continue;
+        }
+        let mut block = DMatrix::zeros(live.len(), cols.len());
+        for (i, &r) in live.iter().enumerate() {
+            match rows.row_over(r, cols) {
+                Some(v) => block.row_mut(i).copy_from_slice(v),
+                None => return false,
+            }
+        }
+        let sv = block.transpose().svd(false, false).singular_values;
+        if sv.len() < live.len() || sv.min() <= PEEL_MARGIN * norm {
+            continue;
+        }
+        for &r in &live {
+            left[r] = false;
+            remaining -= 1;
+            for other in row_bodies[r].iter().flatten() {
+                if !queued[*other] {
+                    queued[*other] = true;
+                    queue.push(*other);
+                }
+            }
+        }
+    }
+    remaining == 0
 }
 
 /// Refuses redundant rows: `gm` (the system's rows `rows`) must have full row rank.
@@ -257,4 +331,57 @@ pub fn meet_jump<S: Equations + ?Sized>(
     st.acc += jump;
     st.lambda.axpy(1.0 / w.cm, &x.rows(n, m).into_owned(), 1.0);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::peels_to_full_rank;
+    use crate::mechanics::multibody::JacobianRows;
+    use std::ops::Range;
+
+    /// A chain of `k` bodies of 3 coordinates: body 0 pinned to the world (2 rows), each next
+    /// one welded to the one before (3 rows: its coordinates minus the other's), and `extra`
+    /// rows appended.
+    fn chain(k: usize, extra: &[([Option<usize>; 2], [f64; 6])]) -> bool {
+        let ranges: Vec<Range<usize>> = (0..k).map(|b| 3 * b..3 * b + 3).collect();
+        let mut rows: Vec<([Option<usize>; 2], [f64; 6])> = vec![
+            ([Some(0), None], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            ([Some(0), None], [0.0, 1.0, 0.0, 0.0, 0.0, 0.0]),
+        ];
+        for b in 1..k {
+            for c in 0..3 {
+                let mut v = [0.0; 6];
+                v[c] = -1.0;
+                v[3 + c] = 1.0;
+                rows.push(([Some(b - 1), Some(b)], v));
+            }
+        }
+        rows.extend_from_slice(extra);
+        let bodies: Vec<[Option<usize>; 2]> = rows.iter().map(|r| r.0).collect();
+        let mut g = JacobianRows::new(3 * k, &ranges, &bodies);
+        for (i, (b, v)) in rows.iter().enumerate() {
+            for (s, body) in b.iter().flatten().enumerate() {
+                for c in 0..3 {
+                    g.add(i, ranges[*body].start + c, v[3 * s + c]);
+                }
+            }
+        }
+        peels_to_full_rank(&ranges, &bodies, &g)
+    }
+
+    #[test]
+    fn a_chain_of_welds_peels_and_a_redundant_or_looped_row_does_not() {
+        assert!(chain(1, &[]));
+        assert!(chain(50, &[]));
+        // a second pin of body 0's x: the same motion twice
+        let again = ([Some(0), None], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        assert!(!chain(50, &[again]));
+        // the last body's angle fixed to the world closes a loop through it: full rank, but
+        // no body's rows peel (4 on the last body's 3 columns), so the SVD decides
+        let angle = ([Some(49), None], [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+        assert!(!chain(50, &[angle]));
+        // nearly redundant (1e-9 of the other): left to the SVD
+        let near = ([Some(0), None], [1.0, 1e-9, 0.0, 0.0, 0.0, 0.0]);
+        assert!(!chain(5, &[near]));
+    }
 }

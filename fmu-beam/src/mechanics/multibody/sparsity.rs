@@ -133,6 +133,15 @@ impl JacobianRows {
             .map(|s| s.at + col - s.col)
     }
 
+    /// The stored values of row `row` over the columns `cols` of one body of its pattern
+    /// (entry k is G[row, cols.start + k]); None where the row does not depend on that body.
+    pub fn row_over(&self, row: usize, cols: &Range<usize>) -> Option<&[f64]> {
+        self.segments[row]
+            .iter()
+            .find(|s| s.len > 0 && s.col == cols.start && s.len == cols.len())
+            .map(|s| &self.values[s.at..s.at + s.len])
+    }
+
     /// Visits (row, col, index of the stored value) of every stored entry, row by row.
     pub fn for_each_entry(&self, mut visit: impl FnMut(usize, usize, usize)) {
         for (row, segs) in self.segments.iter().enumerate() {
