@@ -26,6 +26,7 @@ pub mod plot;
 mod pool;
 mod recentre;
 pub mod report;
+mod run;
 mod runner;
 pub mod truth;
 
@@ -193,6 +194,9 @@ pub struct Study {
     /// Runs the workers ran ahead that the study did not ask for (stopped part-way or
     /// finished), and their CPU seconds: what running ahead cost.
     pub unused: (usize, f64),
+    /// Times a run ahead was paused on a worker for one the study asked for (and went on later,
+    /// the same bit for bit).
+    pub pauses: usize,
     /// Runs of a first study that are not in `runs` (this one is re-centred on its mesh).
     pub earlier_runs: usize,
 }
@@ -359,9 +363,11 @@ pub fn study_with(
         return Err(AccuracyError::Interrupted.into());
     }
     let unused = pool.unused();
+    let pauses = pool.pauses();
     result.map(|mut s: Study| {
         s.jobs = jobs;
         s.unused = unused;
+        s.pauses = pauses;
         s
     })
 }
@@ -869,6 +875,7 @@ fn study_of(
         incomplete: r.incomplete,
         jobs: 1,
         unused: (0, 0.0),
+        pauses: 0,
     };
     if let Some(reference) = &reference {
         truth::judge(&mut study, reference);

@@ -6,142 +6,17 @@
 //! enters its table, so that the choice and every figure are the serial study's (a run is the
 //! same bit for bit on any thread); only CPU and wall seconds differ.
 
-use super::cost::Counts;
-use super::estimate::Series;
-use fmu_beam::{Engine, Scene};
+use super::run::{stretch, to_the_end, Failure, Job, Outcome, Pending, Stretch, POLL};
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-/// What a run needs: the scene at its setting and the grid it records.
-#[derive(Debug, Clone)]
-pub(super) struct Job {
-    pub(super) scene: Scene,
-    pub(super) outputs: Vec<String>,
-    pub(super) start: f64,
-    pub(super) comm: f64,
-    pub(super) n: usize,
-}
-
-impl Job {
-    /// The job's identity: its scene's canonical text and its grid.
-    pub(super) fn key(&self) -> String {
-        format!(
-            "{}\n# grid {:e} {:e} {} {}",
-            self.scene.to_toml_string(),
-            self.start,
-            self.comm,
-            self.n,
-            self.outputs.join(",")
-        )
-    }
-}
-
-/// Why a run has no result.
-#[derive(Debug, Clone, PartialEq)]
-pub(super) enum Failure {
-    /// The engine refused the scene or failed a step: a property of the setting.
-    Failed(String),
-    /// Stopped from outside (the wall-clock safety stop, an interrupt, a cancelled
-    /// speculation): not a property of the setting.
-    Stopped,
-}
-
-/// A finished run: its outputs and counters, or why not; and its CPU seconds.
-#[derive(Debug, Clone)]
-pub(super) struct Outcome {
-    pub(super) result: Result<(Series, Counts), Failure>,
-    pub(super) seconds: f64,
-}
-
-/// CPU seconds this thread has run (the scheduler's account), where Linux says.
-pub(super) fn thread_cpu_seconds() -> Option<f64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse::<f64>()
-        .ok()
-        .map(|ns| ns * 1e-9)
-}
-
-/// Runs `job` over its grid: the outputs at every point and the engine's counters; stops at a
-/// communication point once any of `stop` is raised or `deadline` has passed.
-/// `interrupted`, where given, is asked about five times a second.
-pub(super) fn simulate(
-    job: &Job,
-    stop: &[&AtomicBool],
-    deadline: Option<Instant>,
-    interrupted: Option<&dyn Fn() -> bool>,
-) -> Outcome {
-    let wall = Instant::now();
-    let cpu0 = thread_cpu_seconds();
-    let result = simulate_inner(job, stop, deadline, interrupted);
-    let seconds = match (cpu0, thread_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => wall.elapsed().as_secs_f64(),
-    };
-    Outcome { result, seconds }
-}
-
-fn simulate_inner(
-    job: &Job,
-    stop: &[&AtomicBool],
-    deadline: Option<Instant>,
-    interrupted: Option<&dyn Fn() -> bool>,
-) -> Result<(Series, Counts), Failure> {
-    let mut asked = Instant::now();
-    let failed = |m: String| Failure::Failed(m);
-    let mut e = Engine::new(job.scene.clone());
-    let vrs: Vec<u32> = job
-        .outputs
-        .iter()
-        .map(|o| {
-            e.variables()
-                .by_name(o)
-                .map(|v| v.vr)
-                .ok_or_else(|| failed(format!("the unit has no output {o}")))
-        })
-        .collect::<Result<_, _>>()?;
-    e.exit_initialization().map_err(|x| failed(x.to_string()))?;
-    let mut values = vec![Vec::with_capacity(job.n + 1); vrs.len()];
-    for k in 0..=job.n {
-        let now = Instant::now();
-        if let Some(f) = interrupted.filter(|_| now.duration_since(asked) >= POLL) {
-            asked = now;
-            if f() {
-                return Err(Failure::Stopped);
-            }
-        }
-        if stop.iter().any(|s| s.load(Ordering::Relaxed)) || deadline.is_some_and(|d| now > d) {
-            return Err(Failure::Stopped);
-        }
-        if k > 0 {
-            let t = job.start + (k - 1) as f64 * job.comm;
-            e.do_step(t, job.comm)
-                .map_err(|x| failed(format!("at t = {t} s: {x}")))?;
-        }
-        for (v, &vr) in values.iter_mut().zip(&vrs) {
-            v.push(e.get_real(vr).map_err(|x| failed(x.to_string()))?);
-        }
-    }
-    let mut count = |name: &str| match e.variables().by_name(name).map(|v| v.vr) {
-        Some(vr) => u64::try_from(e.get_integer(vr).unwrap_or(0)).unwrap_or(0),
-        None => 0,
-    };
-    let counts = Counts {
-        steps: count("solver.steps"),
-        iterations: count("solver.newton_iterations"),
-        jacobians: count("solver.jacobians"),
-        points: job.n as u64,
-    };
-    Ok((values, counts))
-}
-
 enum State {
-    Queued(Box<Job>),
-    Running(Arc<AtomicBool>),
+    /// Waiting for a worker; `u64`: its rank (lower = sooner; 0: the study asks for it).
+    Queued(Pending, u64),
+    /// On a worker: its stop flag, its pause flag and its rank.
+    Running(Arc<AtomicBool>, Arc<AtomicBool>, u64),
     Done(Outcome),
 }
 
@@ -154,6 +29,10 @@ struct Inner {
     taken: HashSet<String>,
     /// Runs stopped before their end (gone past), and their CPU seconds.
     stopped: (usize, f64),
+    /// The rank the next speculated job gets.
+    next_rank: u64,
+    /// Runs paused for an asked one.
+    paused: usize,
 }
 
 /// The runs of one study, shared by its thread and the workers.
@@ -197,7 +76,9 @@ impl Pool {
         self.inner.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// A worker's loop: the first queued job, run, stored; until [`Pool::shut_down`].
+    /// A worker's loop: the first queued job, run (or run on where paused), stored; until
+    /// [`Pool::shut_down`]. A run paused for an asked one goes back to the queue, right behind
+    /// the jobs the study asks for.
     pub(super) fn work(&self) {
         let mut g = self.lock();
         loop {
@@ -208,40 +89,99 @@ impl Pool {
                 g = self.changed.wait(g).unwrap_or_else(|p| p.into_inner());
                 continue;
             };
-            let cancel = Arc::new(AtomicBool::new(false));
-            let Some(State::Queued(job)) =
-                g.states.insert(key.clone(), State::Running(cancel.clone()))
-            else {
+            if !matches!(g.states.get(&key), Some(State::Queued(..))) {
+                continue;
+            }
+            let Some(State::Queued(pending, rank)) = g.states.remove(&key) else {
                 continue;
             };
+            let cancel = Arc::new(AtomicBool::new(false));
+            let pause = Arc::new(AtomicBool::new(false));
+            g.states.insert(
+                key.clone(),
+                State::Running(cancel.clone(), pause.clone(), rank),
+            );
             drop(g);
-            let out = simulate(&job, &[&self.stop, &cancel], self.deadline, None);
+            let out = stretch(
+                pending,
+                &[&self.stop, &cancel],
+                Some(&pause),
+                self.deadline,
+                None,
+            );
             g = self.lock();
-            if matches!(out.result, Err(Failure::Stopped)) {
-                g.states.remove(&key);
-                g.stopped.0 += 1;
-                g.stopped.1 += out.seconds;
-            } else {
-                g.states.insert(key, State::Done(out));
+            match out {
+                Stretch::Paused(run) => {
+                    g.paused += 1;
+                    let at = g
+                        .queue
+                        .iter()
+                        .position(|k| !matches!(g.states.get(k), Some(State::Queued(_, 0))))
+                        .unwrap_or(g.queue.len());
+                    g.states
+                        .insert(key.clone(), State::Queued(Pending::Paused(run), rank));
+                    g.queue.insert(at, key);
+                }
+                Stretch::Ended(out) if matches!(out.result, Err(Failure::Stopped)) => {
+                    g.states.remove(&key);
+                    g.stopped.0 += 1;
+                    g.stopped.1 += out.seconds;
+                }
+                Stretch::Ended(out) => {
+                    g.states.insert(key, State::Done(out));
+                }
             }
             self.changed.notify_all();
         }
     }
 
-    /// What the workers ran and the study did not take: runs, CPU seconds (stopped part-way
-    /// or finished).
+    /// Where the study asks for `key` and every worker runs something else, pauses the run it
+    /// will want last (the highest rank), unless one is pausing already.
+    fn make_room(&self, g: &Inner, key: &str) {
+        let mut running = 0;
+        let mut last: Option<(&AtomicBool, u64)> = None;
+        for (k, s) in &g.states {
+            if let State::Running(_, pause, rank) = s {
+                if k == key || pause.load(Ordering::Relaxed) {
+                    return;
+                }
+                running += 1;
+                if last.is_none_or(|(_, r)| *rank > r) {
+                    last = Some((pause, *rank));
+                }
+            }
+        }
+        if running >= self.workers {
+            if let Some((pause, _)) = last {
+                pause.store(true, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// What the workers ran and the study did not take: runs, CPU seconds (stopped part-way,
+    /// paused and never gone on with, or finished).
     pub(super) fn unused(&self) -> (usize, f64) {
         let g = self.lock();
         let (mut n, mut seconds) = g.stopped;
         for (k, s) in &g.states {
-            if let State::Done(o) = s {
-                if !g.taken.contains(k) {
+            match s {
+                State::Done(o) if !g.taken.contains(k) => {
                     n += 1;
                     seconds += o.seconds;
                 }
+                State::Queued(Pending::Paused(r), _) => {
+                    n += 1;
+                    seconds += r.seconds;
+                }
+                _ => {}
             }
         }
         (n, seconds)
+    }
+
+    /// How many times a run was paused for one the study asked for.
+    pub(super) fn pauses(&self) -> usize {
+        self.lock().paused
     }
 
     /// Ends the workers' loops (queued jobs are dropped, running ones stopped).
@@ -250,7 +190,7 @@ impl Pool {
         g.shutdown = true;
         g.queue.clear();
         for s in g.states.values() {
-            if let State::Running(c) = s {
+            if let State::Running(c, ..) = s {
                 c.store(true, Ordering::Relaxed);
             }
         }
@@ -266,27 +206,42 @@ impl Pool {
         for job in jobs {
             let key = job.key();
             if !g.states.contains_key(&key) {
-                g.states.insert(key.clone(), State::Queued(Box::new(job)));
+                g.next_rank += 1;
+                let rank = g.next_rank;
+                g.states.insert(
+                    key.clone(),
+                    State::Queued(Pending::Fresh(Box::new(job)), rank),
+                );
                 g.queue.push_back(key);
             }
         }
         self.changed.notify_all();
     }
 
-    /// Drops the queued jobs and stops the running ones that `keep` does not name: the study
-    /// has gone past them.
+    /// Drops the queued (and paused) jobs and stops the running ones that `keep` does not
+    /// name: the study has gone past them.
     pub(super) fn forget(&self, keep: &[String]) {
         let mut g = self.lock();
-        let Inner { states, queue, .. } = &mut *g;
+        let Inner {
+            states,
+            queue,
+            stopped,
+            ..
+        } = &mut *g;
         queue.retain(|k| {
             let kept = keep.contains(k);
             if !kept {
-                states.remove(k);
+                if let Some(State::Queued(p, _)) = states.remove(k) {
+                    if let Pending::Paused(r) = p {
+                        stopped.0 += 1;
+                        stopped.1 += r.seconds;
+                    }
+                }
             }
             kept
         });
         for (k, s) in states.iter() {
-            if let State::Running(c) = s {
+            if let State::Running(c, ..) = s {
                 if !keep.contains(k) {
                     c.store(true, Ordering::Relaxed);
                 }
@@ -300,13 +255,13 @@ impl Pool {
         let key = job.key();
         let mut g = self.lock();
         loop {
-            match g.states.get(&key) {
+            match g.states.get_mut(&key) {
                 Some(State::Done(o)) => {
                     let o = o.clone();
                     g.taken.insert(key);
                     return o;
                 }
-                Some(State::Running(_)) => {
+                Some(State::Running(..)) => {
                     if interrupted() {
                         self.stop.store(true, Ordering::Relaxed);
                     }
@@ -316,11 +271,16 @@ impl Pool {
                         .map(|(g, _)| g)
                         .unwrap_or_else(|p| p.into_inner().0);
                 }
-                Some(State::Queued(_)) if self.workers > 0 => {
-                    // asked for now: first in the queue
+                Some(State::Queued(_, rank)) if self.workers > 0 => {
+                    // asked for now: first in the queue, and a worker for it
+                    *rank = 0;
                     g.queue.retain(|k| k != &key);
                     g.queue.push_front(key.clone());
+                    self.make_room(&g, &key);
                     self.changed.notify_all();
+                    if interrupted() {
+                        self.stop.store(true, Ordering::Relaxed);
+                    }
                     g = self
                         .changed
                         .wait_timeout(g, POLL)
@@ -333,20 +293,28 @@ impl Pool {
                     {
                         return stopped();
                     }
-                    g.states
-                        .insert(key.clone(), State::Queued(Box::new(job.clone())));
+                    g.states.insert(
+                        key.clone(),
+                        State::Queued(Pending::Fresh(Box::new(job.clone())), 0),
+                    );
                     g.queue.push_front(key.clone());
                     self.changed.notify_all();
                 }
-                Some(State::Queued(_)) | None => {
+                Some(State::Queued(..)) | None => {
                     if self.stop.load(Ordering::Relaxed)
                         || self.deadline.is_some_and(|d| Instant::now() > d)
                     {
                         return stopped();
                     }
                     g.queue.retain(|k| k != &key);
+                    let pending = match g.states.remove(&key) {
+                        Some(State::Queued(p, _)) => p,
+                        _ => Pending::Fresh(Box::new(job.clone())),
+                    };
                     let cancel = Arc::new(AtomicBool::new(false));
-                    g.states.insert(key.clone(), State::Running(cancel.clone()));
+                    let pause = Arc::new(AtomicBool::new(false));
+                    g.states
+                        .insert(key.clone(), State::Running(cancel.clone(), pause, 0));
                     drop(g);
                     let poll = || {
                         let i = interrupted();
@@ -355,7 +323,8 @@ impl Pool {
                         }
                         i
                     };
-                    let out = simulate(&job, &[&self.stop, &cancel], self.deadline, Some(&poll));
+                    let out =
+                        to_the_end(pending, &[&self.stop, &cancel], self.deadline, Some(&poll));
                     g = self.lock();
                     if matches!(out.result, Err(Failure::Stopped)) {
                         g.states.remove(&key);
@@ -378,49 +347,12 @@ fn stopped() -> Outcome {
     }
 }
 
-/// How often a waiting or running study asks whether it was interrupted.
-const POLL: Duration = Duration::from_millis(200);
-
 #[cfg(test)]
 mod tests {
-    use super::super::cost::Shape;
+    use super::super::run::simulate;
+    use super::super::run::tests::crank_job;
     use super::*;
-
-    /// A run's counted cost is a property of its setting: the same number, bit for bit, on
-    /// every run (here three, one of them on another thread while this one also runs).
-    #[test]
-    fn the_counted_cost_is_the_same_number_on_every_run() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenes/slider_crank_rigid_crank.toml");
-        let mut scene = Scene::load(&path).unwrap();
-        scene.solver.max_step = 5e-3;
-        let job = Job {
-            scene,
-            outputs: vec!["slider.position".into()],
-            start: 0.0,
-            comm: 1e-2,
-            n: 40,
-        };
-        let shape = Shape::of(&job.scene);
-        let counted = |o: Outcome| {
-            let (y, c) = o.result.unwrap();
-            (y, c, shape.work(&c).to_bits())
-        };
-        let first = counted(simulate(&job, &[], None, None));
-        let (second, third) = std::thread::scope(|s| {
-            let other = s.spawn(|| counted(simulate(&job, &[], None, None)));
-            let here = counted(simulate(&job, &[], None, None));
-            (here, other.join().unwrap())
-        });
-        assert!(
-            first.1.iterations > first.1.steps && first.1.jacobians > 0,
-            "{:?}",
-            first.1
-        );
-        assert!(f64::from_bits(first.2) > 0.0);
-        assert_eq!(first, second);
-        assert_eq!(first, third);
-    }
+    use fmu_beam::Scene;
 
     /// A job the study has gone past is stopped and never stored; one it asks for is run
     /// (here by the study's own thread, the pool having no worker).
@@ -449,5 +381,38 @@ mod tests {
             pool.take(other, &|| false).result,
             Err(Failure::Stopped)
         ));
+    }
+
+    /// With its one worker busy with a run ahead, a run the study asks for pauses it: the asked
+    /// run is done first, the paused one goes on afterwards and ends as if never paused.
+    #[test]
+    fn an_asked_run_pauses_a_run_ahead_that_then_ends_unchanged() {
+        let ahead = crank_job(300, 2e-4);
+        let asked = crank_job(5, 2e-3);
+        let pool = Pool::new(1, 600.0);
+        std::thread::scope(|s| {
+            s.spawn(|| pool.work());
+            pool.speculate(vec![ahead.clone()]);
+            // wait until the worker runs it
+            while !matches!(
+                pool.lock().states.get(&ahead.key()),
+                Some(State::Running(..))
+            ) {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            let o = pool.take(asked.clone(), &|| false);
+            assert_eq!(
+                o.result.unwrap().0,
+                simulate(&asked, &[], None, None).result.unwrap().0
+            );
+            assert_eq!(pool.pauses(), 1, "the run ahead was not paused");
+            let a = pool.take(ahead.clone(), &|| false);
+            pool.shut_down();
+            let whole = simulate(&ahead, &[], None, None).result.unwrap();
+            let (y, c) = a.result.unwrap();
+            assert_eq!(y, whole.0);
+            assert_eq!((c.steps, c.iterations), (whole.1.steps, whole.1.iterations));
+            assert_eq!(pool.unused(), (0, 0.0));
+        });
     }
 }

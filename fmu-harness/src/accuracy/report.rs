@@ -328,8 +328,9 @@ pub fn markdown(study: &Study) -> String {
     if study.jobs > 1 {
         let _ = writeln!(
             s,
-            "- run ahead and not asked for: {} runs, {:.2} CPU s (not in the table)",
-            study.unused.0, study.unused.1
+            "- run ahead and not asked for: {} runs, {:.2} CPU s (not in the table); runs ahead \
+             paused for an asked one: {}",
+            study.unused.0, study.unused.1, study.pauses
         );
     }
     for n in &study.notes {
@@ -369,6 +370,7 @@ pub fn json(study: &Study) -> String {
         "jobs": study.jobs,
         "unused_runs": study.unused.0,
         "unused_cpu_s": study.unused.1,
+        "paused_runs": study.pauses,
     });
     format!("{v:#}\n")
 }

@@ -4,7 +4,8 @@
 
 use super::cost::{Counts, Shape};
 use super::estimate::Series;
-use super::pool::{Failure, Job, Pool};
+use super::pool::Pool;
+use super::run::{Failure, Job};
 use super::{Role, Run, Setting};
 use fmu_beam::Scene;
 use std::time::Instant;
