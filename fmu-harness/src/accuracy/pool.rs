@@ -231,11 +231,9 @@ impl Pool {
         queue.retain(|k| {
             let kept = keep.contains(k);
             if !kept {
-                if let Some(State::Queued(p, _)) = states.remove(k) {
-                    if let Pending::Paused(r) = p {
-                        stopped.0 += 1;
-                        stopped.1 += r.seconds;
-                    }
+                if let Some(State::Queued(Pending::Paused(r), _)) = states.remove(k) {
+                    stopped.0 += 1;
+                    stopped.1 += r.seconds;
                 }
             }
             kept
