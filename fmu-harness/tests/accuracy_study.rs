@@ -554,6 +554,13 @@ fn the_same_study_gives_the_same_choice_and_figures_under_load_and_on_two_thread
     assert_eq!(a.predicted.to_bits(), b.predicted.to_bits());
     assert_eq!(serial.work.to_bits(), parallel.work.to_bits());
     assert_eq!(serial.notes, parallel.notes);
+    // the re-centred study ran too: its runs ahead (the mesh ladder during the first study's
+    // check of its choice) are covered
+    assert!(
+        serial.notes.iter().any(|n| n.starts_with("re-centred")),
+        "{:?}",
+        serial.notes
+    );
     assert_eq!((serial.jobs, parallel.jobs), (1, 2));
     assert!(serial.incomplete.is_none() && parallel.incomplete.is_none());
 }

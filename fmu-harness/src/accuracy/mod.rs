@@ -349,7 +349,7 @@ pub fn study_with(
             s.spawn(|| pool.work());
         }
         let out = (|| {
-            let first = study_of(scene, opts, &pool, interrupted, opts.recentre)?;
+            let first = study_of(scene, opts, &pool, interrupted, opts.recentre, None)?;
             Ok(if opts.recentre {
                 recentre::recentred(scene, opts, first, &pool, interrupted)
             } else {
@@ -415,12 +415,21 @@ pub(crate) fn recentre_mesh(
 
 /// One study of `base` (its runs through `pool`); `ahead`: a re-centred study may follow,
 /// whose time ladder is handed to the pool as soon as the choice says which mesh it runs at.
+/// The rung of a time ladder from `h0` whose step is `h` (h0 / 2^k), if any.
+fn level_of(h0: f64, h: f64) -> Option<usize> {
+    let k = (h0 / h).log2().round();
+    (k.is_finite() && (0.0..MAX_TIME_LEVELS as f64).contains(&k))
+        .then_some(k as usize)
+        .filter(|&k| (h0 / 2f64.powi(k as i32) - h).abs() <= 1e-9 * h)
+}
+
 fn study_of(
     base: &Scene,
     opts: &Options,
     pool: &Pool,
     interrupted: &dyn Fn() -> bool,
     ahead: bool,
+    mesh_hint: Option<f64>,
 ) -> Result<Study, crate::HarnessError> {
     let base = base.clone();
     {
@@ -508,6 +517,24 @@ fn study_of(
     let asked: Vec<Setting> = (0..=opts.levels).rev().map(|k| at(k, 0)).collect();
     r.speculate(&asked[1..]);
     r.speculate(&asked[..1]);
+    // run ahead, after those: the mesh ladder at the step an earlier study of this scene ran
+    // it at (`mesh_hint`: the re-centred study's mesh phase then finds its longest runs under way)
+    let has_mesh = base.beams.iter().any(refinable);
+    let meshes_at = |level: usize| -> Vec<Setting> {
+        let mut v: Vec<Setting> = (1..opts.mesh_levels.max(2))
+            .rev()
+            .map(|j| at(level, j as i32))
+            .collect();
+        if coarsenable(&base) {
+            v.push(at(level, -1));
+        }
+        v
+    };
+    let hinted = match mesh_hint.and_then(|h| level_of(h0, h)) {
+        Some(k) if has_mesh && opts.mesh_levels > 1 => meshes_at(k),
+        _ => Vec::new(),
+    };
+    r.speculate(&hinted);
     for k in 0..MAX_TIME_LEVELS {
         if k >= opts.levels
             && (time_runs.last() == Some(&None)
@@ -524,7 +551,7 @@ fn study_of(
         }
         time_runs.push(i);
     }
-    r.forget();
+    r.forget_but(&hinted);
     let time_tail = fine_end(&r, &time_runs);
     let Some(&finest) = time_tail.last() else {
         if r.incomplete.is_some() {
@@ -558,7 +585,6 @@ fn study_of(
     // the mesh ladder, at the coarsest step whose time share is within a quarter of the
     // target (the mesh runs are then settings the choice can take), else the finest; past
     // `opts.mesh_levels` it goes on as the time ladder does
-    let has_mesh = base.beams.iter().any(refinable);
     let tail_levels: Vec<usize> = (0..time_runs.len())
         .filter(|&k| time_runs[k].is_some_and(|i| time_tail.contains(&i)))
         .collect();
@@ -570,13 +596,9 @@ fn study_of(
     let mut mesh_runs: Vec<Option<usize>> = vec![time_runs[mesh_level]];
     if has_mesh {
         // run ahead: the asked meshes, finest first, the halved one, and one mesh past them
-        let mut ahead_meshes: Vec<Setting> = (1..opts.mesh_levels.max(2))
-            .rev()
-            .map(|j| at(mesh_level, j as i32))
-            .collect();
-        if coarsenable(&base) {
-            ahead_meshes.push(at(mesh_level, -1));
-        }
+        // (what was run ahead at another step is dropped)
+        let ahead_meshes = meshes_at(mesh_level);
+        r.forget_but(&ahead_meshes);
         r.speculate(&ahead_meshes);
         let mut cost = time_runs[mesh_level].map_or(0.0, |i| r.runs[i].work);
         for j in 1..MAX_MESH_LEVELS {
@@ -731,6 +753,15 @@ fn study_of(
             if let Some(m) =
                 recentre_mesh(j as i32 - offset as i32, halved_error, margin, opts.target)
             {
+                // its mesh ladder at this study's mesh step, finest first (the longest runs of
+                // all: a core takes them while the other checks this choice)
+                if has_mesh && opts.mesh_levels > 1 {
+                    ahead_runs.extend(
+                        (1..opts.mesh_levels.max(2))
+                            .rev()
+                            .map(|i| at(mesh_level, m + i as i32)),
+                    );
+                }
                 // as deep as this study's ladder went (the finest first: the longest)
                 ahead_runs.extend(
                     (0..time_runs.len().max(opts.levels))

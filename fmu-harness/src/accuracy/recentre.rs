@@ -67,7 +67,13 @@ pub(super) fn recentred(
     let second = if o.max_runs == 0 || o.max_work <= 0.0 {
         Err("the budget is spent".to_string())
     } else {
-        study_of(&moved, &o, pool, interrupted, false).map_err(|e| e.to_string())
+        // its mesh ladder probably runs at the step the first one's did
+        let hint = first
+            .runs
+            .iter()
+            .find(|r| r.role == Role::Mesh)
+            .map(|r| r.setting.step);
+        study_of(&moved, &o, pool, interrupted, false, hint).map_err(|e| e.to_string())
     };
     match second {
         Ok(mut second)

@@ -133,6 +133,16 @@ impl Runner<'_> {
         self.pool.forget(&[]);
     }
 
+    /// Drops what was run ahead and not asked for, but `settings`.
+    pub(super) fn forget_but(&self, settings: &[Setting]) {
+        let keep: Vec<String> = settings
+            .iter()
+            .filter_map(|s| self.job(s).ok())
+            .map(|j| j.key())
+            .collect();
+        self.pool.forget(&keep);
+    }
+
     /// Runs `setting` unless the budget would be passed (runs, or counted work with this
     /// run's predicted work); the run's index. Nothing runs once the study was stopped.
     pub(super) fn run(&mut self, role: Role, setting: Setting, predicted: f64) -> Option<usize> {
