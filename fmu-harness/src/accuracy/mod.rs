@@ -413,8 +413,6 @@ pub(crate) fn recentre_mesh(
     }
 }
 
-/// One study of `base` (its runs through `pool`); `ahead`: a re-centred study may follow,
-/// whose time ladder is handed to the pool as soon as the choice says which mesh it runs at.
 /// The rung of a time ladder from `h0` whose step is `h` (h0 / 2^k), if any.
 fn level_of(h0: f64, h: f64) -> Option<usize> {
     let k = (h0 / h).log2().round();
@@ -423,6 +421,10 @@ fn level_of(h0: f64, h: f64) -> Option<usize> {
         .filter(|&k| (h0 / 2f64.powi(k as i32) - h).abs() <= 1e-9 * h)
 }
 
+/// One study of `base` (its runs through `pool`); `ahead`: a re-centred study may follow,
+/// whose mesh and time ladders are handed to the pool as soon as the choice says which mesh it
+/// runs at; `mesh_hint`: the step an earlier study ran its mesh ladder at, whose meshes are run
+/// ahead during the time ladder.
 fn study_of(
     base: &Scene,
     opts: &Options,
