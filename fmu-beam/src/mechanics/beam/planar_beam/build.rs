@@ -101,6 +101,7 @@ impl PlanarBeam {
             dff,
             flange_a: node_map(0, 0.0),
             flange_b: node_map(elements, length),
+            kept_index: kept_index(&kept),
             kept,
             geometric_stiffening: options.geometric_stiffening,
             options,
@@ -236,4 +237,13 @@ pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix
         .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
         .collect();
     DMatrix::from_columns(&cols)
+}
+
+/// Reduced index of each full nodal coordinate, where kept.
+fn kept_index(kept: &[usize]) -> Vec<Option<usize>> {
+    let mut index = vec![None; kept.iter().max().map_or(0, |&k| k + 1)];
+    for (k, &f) in kept.iter().enumerate() {
+        index[f] = Some(k);
+    }
+    index
 }
