@@ -8,7 +8,7 @@
 //! system's size by [`prefers_sparse`], a rule read off the measurements of `fmu-harness
 //! linear-solvers` (docs/linear_algebra.md), and the bordered band by [`prefers_bordered`].
 
-use super::bordered_band::BorderedBand;
+use super::bordered_band::{BorderedBand, Refusal};
 use crate::mechanics::multibody::{Block, BlockDiagonal, Equations, JacobianRows, Point};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{
@@ -146,7 +146,8 @@ enum Factors {
     Bordered {
         band: Box<BorderedBand>,
         dense: Option<Box<DenseLu>>,
-        fallen_back: bool,
+        /// Why the last factorization fell back, if it did.
+        refusal: Option<Refusal>,
         /// Factorizations that fell back to the dense LU.
         fallbacks: u64,
     },
@@ -176,7 +177,7 @@ impl IterationMatrix {
             Factors::Bordered {
                 band: Box::new(BorderedBand::new(n + m, &tails, width)),
                 dense: None,
-                fallen_back: false,
+                refusal: None,
                 fallbacks: 0,
             }
         } else if sparse {
@@ -214,6 +215,14 @@ impl IterationMatrix {
         match &self.factors {
             Factors::Bordered { fallbacks, .. } => *fallbacks,
             _ => 0,
+        }
+    }
+
+    /// Why the bordered banded LU refused the last factorization (the dense LU did it).
+    pub fn refusal(&self) -> Option<Refusal> {
+        match &self.factors {
+            Factors::Bordered { refusal, .. } => *refusal,
+            _ => None,
         }
     }
 
@@ -290,7 +299,7 @@ impl IterationMatrix {
             Factors::Bordered {
                 band,
                 dense,
-                fallen_back,
+                refusal,
                 fallbacks,
             } => {
                 band.clear();
@@ -305,8 +314,8 @@ impl IterationMatrix {
                     band.set(n + row, col, g[k]);
                     band.set(col, n + row, g[k]);
                 });
-                *fallen_back = band.factorize().is_err();
-                if *fallen_back {
+                *refusal = band.factorize().err();
+                if refusal.is_some() {
                     // the dense LU, as LinearSolver::Dense would factorize it
                     *fallbacks += 1;
                     let dim = n + rows.nrows();
@@ -364,10 +373,10 @@ impl IterationMatrix {
             Factors::Bordered {
                 band,
                 dense,
-                fallen_back,
+                refusal,
                 ..
             } => {
-                if *fallen_back {
+                if refusal.is_some() {
                     return dense
                         .as_ref()
                         .and_then(|d| d.1.as_ref())
