@@ -1,10 +1,11 @@
-//! A body block stored as an arrow around a band: the first `head` rows and columns (a beam's
-//! frame coordinates, coupled with all) dense, the rest (its deformation coordinates, each
-//! coupled only with those of its own and the neighbouring elements) within a half bandwidth.
-//! A beam of n elements then fills O(n) entries of M, K_t and C_t instead of O(n²), and the
-//! iteration matrix can eliminate the band in O(n) (`integrator/bordered_band.rs`).
+//! Banded storage of a planar beam: its constant deformation matrices ([`Banded`]) and its
+//! blocks of M, K_t and C_t as an arrow around a band ([`ArrowBand`]: the first `head` rows and
+//! columns, the frame coordinates coupled with all, dense; the deformation coordinates, each
+//! coupled only within the elements of its node, within a half bandwidth). A beam of n elements
+//! then builds and fills O(n) entries instead of O(n²), and the iteration matrix can eliminate
+//! the band in O(n) (`integrator/bordered_band.rs`).
 
-use nalgebra::DMatrixViewMut;
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView};
 use std::ops::{Index, IndexMut};
 
 /// Read for every entry outside the pattern.
@@ -155,6 +156,98 @@ impl IndexMut<(usize, usize)> for ArrowBand {
     }
 }
 
+/// A square matrix stored within a half bandwidth of its diagonal: a beam's constant
+/// deformation matrices (m_ff, W, K_ff, D_ff), each element coupling only its own coordinates,
+/// in O(n) instead of O(n²).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Banded {
+    n: usize,
+    width: usize,
+    /// Row i over columns i − width ..= i + width, row-major.
+    data: Vec<f64>,
+}
+
+impl Banded {
+    pub fn zeros(n: usize, width: usize) -> Banded {
+        Banded {
+            n,
+            width,
+            data: vec![0.0; n * (2 * width + 1)],
+        }
+    }
+
+    /// The dense matrix `d`, all of it (half bandwidth n − 1).
+    pub fn from_dense(d: &DMatrix<f64>) -> Banded {
+        let n = d.nrows();
+        let mut b = Banded::zeros(n, n.saturating_sub(1));
+        for j in 0..n {
+            for i in 0..n {
+                b[(i, j)] = d[(i, j)];
+            }
+        }
+        b
+    }
+
+    pub fn nrows(&self) -> usize {
+        self.n
+    }
+
+    /// Half bandwidth.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn to_dense(&self) -> DMatrix<f64> {
+        DMatrix::from_fn(self.n, self.n, |i, j| self[(i, j)])
+    }
+
+    /// The matrix times x.
+    pub fn scaled(&self, x: f64) -> Banded {
+        Banded {
+            data: self.data.iter().map(|a| a * x).collect(),
+            ..self.clone()
+        }
+    }
+
+    /// The product with a vector, column by column.
+    pub fn mul_vec(&self, x: &DVectorView<f64>) -> DVector<f64> {
+        let mut y = DVector::zeros(self.n);
+        for j in 0..self.n {
+            for i in j.saturating_sub(self.width)..(j + self.width + 1).min(self.n) {
+                y[i] += self[(i, j)] * x[j];
+            }
+        }
+        y
+    }
+
+    #[inline]
+    fn slot(&self, i: usize, j: usize) -> Option<usize> {
+        (i < self.n && j < self.n && i.abs_diff(j) <= self.width)
+            .then(|| i * (2 * self.width + 1) + j + self.width - i)
+    }
+}
+
+impl Index<(usize, usize)> for Banded {
+    type Output = f64;
+    #[inline]
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        self.slot(i, j).map_or(&ZERO, |k| &self.data[k])
+    }
+}
+
+impl IndexMut<(usize, usize)> for Banded {
+    #[inline]
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        match self.slot(i, j) {
+            Some(k) => &mut self.data[k],
+            None => panic!(
+                "entry ({i}, {j}) is outside the band (order {}, half bandwidth {})",
+                self.n, self.width
+            ),
+        }
+    }
+}
+
 /// What a body writes its blocks of M, K_t and C_t through: a dense view or an arrow band.
 pub trait BlockMut: IndexMut<(usize, usize), Output = f64> {
     /// Sets every stored entry to zero.
@@ -195,7 +288,6 @@ impl BlockMut for BandMut<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{DMatrix, DVector};
 
     #[test]
     fn entries_multiply_and_expand_like_the_dense_matrix() {

@@ -10,7 +10,7 @@
 //! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
 //! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
 
-use super::band::BlockMut;
+use super::band::{Banded, BlockMut};
 use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
 use super::FloatingFrame;
@@ -165,13 +165,13 @@ pub struct PlanarBeam {
     /// b = ∫ρ (ū0₁ S₂ - ū0₂ S₁) dV, the constant part of Ī_θf.
     pub b: DVector<f64>,
     /// m_ff = ∫ρ SᵀS dV.
-    pub mff: DMatrix<f64>,
+    pub mff: Banded,
     /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
-    pub w: DMatrix<f64>,
+    pub w: Banded,
     /// K_ff, the linear stiffness matrix over the kept coordinates.
-    pub kff: DMatrix<f64>,
+    pub kff: Banded,
     /// D_ff = β K_ff, the stiffness-proportional Rayleigh damping on the strain rates.
-    pub dff: DMatrix<f64>,
+    pub dff: Banded,
     /// Flange a: the material point at the root (x = 0).
     pub flange_a: PointMap,
     /// Flange b: the material point at the tip (x = length).
@@ -538,7 +538,7 @@ impl PlanarBeam {
         } else {
             0.0
         };
-        0.5 * f.dot(&(&self.kff * f)) + extra
+        0.5 * f.dot(&self.kff.mul_vec(&f)) + extra
     }
 
     /// Potential energy of gravity -g·∫ρ r dV (J).
@@ -605,7 +605,7 @@ impl PlanarBeam {
         if load.amax() == 0.0 {
             return None; // the frame holds the tip
         }
-        let q = self.kff.clone().lu().solve(&load)?;
+        let q = self.kff.to_dense().lu().solve(&load)?;
         let scale = tip / load.dot(&q);
         scale.is_finite().then(|| q * scale)
     }

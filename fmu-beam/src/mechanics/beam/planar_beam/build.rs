@@ -3,6 +3,7 @@
 //! conditions and the options applied (no axial coordinates, band structure, modal truncation).
 
 use super::*;
+use crate::mechanics::beam::band::Banded;
 
 impl PlanarBeam {
     /// The full model: the terms of [`BeamOptions::default`] (all but geometric stiffening),
@@ -62,7 +63,7 @@ impl PlanarBeam {
         let full = kept_integrals(length, elements, mu, ea, ej, &index, kept.len());
         let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
         let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
-        let dff = &full.kff * rayleigh_beta;
+        let dff = full.kff.scaled(rayleigh_beta);
         let mass = mu * length;
         let node_map = |node: usize, x: f64| {
             let mut sp_full = DMatrix::zeros(2, n_full);
@@ -156,15 +157,15 @@ impl PlanarBeam {
     /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
     /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
     pub(super) fn truncated(mut self, k: usize) -> PlanarBeam {
-        let phi = lowest_modes(&self.kff, &self.mff, k);
+        let phi = lowest_modes(&self.kff.to_dense(), &self.mff.to_dense(), k);
         let pt = phi.transpose();
         self.sbar = &self.sbar * &phi;
         self.a = &pt * &self.a;
         self.b = &pt * &self.b;
-        self.w = &pt * &self.w * &phi;
-        self.mff = &pt * &self.mff * &phi;
-        self.kff = &pt * &self.kff * &phi;
-        self.dff = &self.kff * self.rayleigh_beta;
+        self.w = Banded::from_dense(&(&pt * self.w.to_dense() * &phi));
+        self.mff = Banded::from_dense(&(&pt * self.mff.to_dense() * &phi));
+        self.kff = Banded::from_dense(&(&pt * self.kff.to_dense() * &phi));
+        self.dff = self.kff.scaled(self.rayleigh_beta);
         for map in [&mut self.flange_a, &mut self.flange_b] {
             reduce_map(map, &phi);
         }
@@ -178,9 +179,9 @@ pub(super) struct KeptIntegrals {
     sbar: DMatrix<f64>,
     a: DVector<f64>,
     b: DVector<f64>,
-    mff: DMatrix<f64>,
-    w: DMatrix<f64>,
-    kff: DMatrix<f64>,
+    mff: Banded,
+    w: Banded,
+    kff: Banded,
 }
 
 /// Integrals of eq. (11) over all N elements (eq. (8)–(12)), each element's entries added
@@ -197,13 +198,19 @@ pub(super) fn kept_integrals(
     nk: usize,
 ) -> KeptIntegrals {
     let l = length / elements as f64;
+    let of_element =
+        |j: usize| (0..ELEMENT_DOFS).filter_map(move |p| index.get(3 * j + p).copied().flatten());
+    let width = (0..elements)
+        .filter_map(|j| Some(of_element(j).max()? - of_element(j).min()?))
+        .max()
+        .unwrap_or(0);
     let mut out = KeptIntegrals {
         sbar: DMatrix::zeros(2, nk),
         a: DVector::zeros(nk),
         b: DVector::zeros(nk),
-        mff: DMatrix::zeros(nk, nk),
-        w: DMatrix::zeros(nk, nk),
-        kff: DMatrix::zeros(nk, nk),
+        mff: Banded::zeros(nk, width),
+        w: Banded::zeros(nk, width),
+        kff: Banded::zeros(nk, width),
     };
     let ke = planar_element::stiffness(ea, ej, l);
     for j in 0..elements {
