@@ -1,7 +1,8 @@
 //! The iteration matrix of one floating frame of many elements on the bordered banded LU
 //! (`integrator/bordered_band.rs`) against the dense LU: `LinearSolver::Auto` takes it for 32
-//! elements and not for 4, it solves what the dense matrices of `Equations` give, and a run
-//! ends at the same tip height with the same Newton iterations as the dense path.
+//! elements and not for 4, it solves what the dense matrices of `Equations` give, a run ends at
+//! the same tip height with the same Newton iterations as the dense path, and a band without
+//! pivots goes to the dense LU.
 
 use super::common::scene;
 use crate::integrator::{
@@ -118,4 +119,31 @@ fn a_32_element_frame_runs_to_the_same_tip_height_under_auto_and_dense() {
     assert!(diff < 1e-9, "{diff:e}");
     assert_eq!(auto.1.steps, dense.1.steps);
     assert_eq!(auto.1.newton_iterations, dense.1.newton_iterations);
+}
+
+#[test]
+fn a_band_without_pivots_falls_back_to_the_dense_lu() {
+    // C_t alone at rest, without damping: the band is zero, the bordered LU refuses it and the
+    // dense LU, not a wrong solution, says the matrix is singular
+    let (sys, st, _) = built(&one_frame(32));
+    let mut matrix = IterationMatrix::new(&sys, LinearSolver::Auto);
+    let at = st.point();
+    let rest = DVector::zeros(sys.n());
+    let at = crate::mechanics::multibody::Point { v: &rest, ..at };
+    let w = crate::integrator::Scaling {
+        d: 0.0,
+        cm: 0.0,
+        cc: 1.0,
+    };
+    assert!(!matrix.factorize(&sys, &at, w));
+    assert_eq!(matrix.fallbacks(), 1);
+    assert!(matches!(
+        matrix.refusal(),
+        Some(crate::integrator::bordered_band::Refusal::TinyPivot { .. })
+    ));
+    assert!(!matrix.solve_mut(&mut DVector::zeros(sys.n() + sys.m())));
+    // a regular matrix again: the bordered LU takes it back
+    let w = iteration_scaling(1.0, 1e-3);
+    assert!(matrix.factorize(&sys, &st.point(), w));
+    assert_eq!((matrix.fallbacks(), matrix.refusal()), (1, None));
 }
