@@ -122,9 +122,9 @@ fn exact_fe_tip(scene: &Scene, t: f64) -> f64 {
     use fmu_beam::mechanics::PlanarBeam;
     let b = PlanarBeam::from_spec(&scene.beams[0]);
     let q0 = b.static_tip_shape(0.01).unwrap();
-    let chol = b.mff.clone().cholesky().unwrap();
+    let chol = b.mff.to_dense().cholesky().unwrap();
     let linv = chol.l().try_inverse().unwrap();
-    let a = &linv * &b.kff * linv.transpose();
+    let a = &linv * &b.kff.to_dense() * linv.transpose();
     let eig = ((&a + a.transpose()) * 0.5).symmetric_eigen();
     let y0 = eig.eigenvectors.transpose() * (chol.l().transpose() * &q0);
     let yt = nalgebra::DVector::from_fn(y0.len(), |k, _| {

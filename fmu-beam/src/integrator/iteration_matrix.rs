@@ -2,11 +2,14 @@
 //! [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]], assembled from the system's body blocks and
 //! constraint rows ([`crate::mechanics::multibody::sparsity`]) and factorized either dense (nalgebra's LU
 //! with partial pivoting) or sparse (faer's sparse LU: the fill-reducing column ordering and
-//! symbolic analysis once per system, only the numeric factorization at each evaluation).
-//! [`LinearSolver::Auto`] chooses from the system's size by [`prefers_sparse`], a rule read off
-//! the measurements of `fmu-harness linear-solvers` (docs/linear_algebra.md).
+//! symbolic analysis once per system, only the numeric factorization at each evaluation) or,
+//! for a beam's banded block, bordered banded (`bordered_band.rs`: the band eliminated first,
+//! the frame coordinates and multipliers last). [`LinearSolver::Auto`] chooses from the
+//! system's size by [`prefers_sparse`], a rule read off the measurements of `fmu-harness
+//! linear-solvers` (docs/linear_algebra.md), and the bordered band by [`prefers_bordered`].
 
-use crate::mechanics::multibody::{BlockDiagonal, Equations, JacobianRows, Point};
+use super::bordered_band::{BorderedBand, Refusal};
+use crate::mechanics::multibody::{Block, BlockDiagonal, Equations, JacobianRows, Point};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
@@ -14,11 +17,13 @@ use faer::sparse::linalg::lu::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
+use std::ops::Range;
 
 /// How the iteration matrix is factorized.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LinearSolver {
-    /// Dense or sparse, by the system's size (`prefers_sparse`).
+    /// Bordered band, dense or sparse, by the system's size and blocks (`prefers_bordered`,
+    /// `prefers_sparse`).
     #[default]
     Auto,
     /// nalgebra's dense LU with partial pivoting, at every size.
@@ -43,6 +48,55 @@ pub const SPARSE_MAX_BLOCK_SHARE: f64 = 0.5;
 pub fn prefers_sparse(unknowns: usize, largest_block: usize) -> bool {
     unknowns >= SPARSE_MIN_SIZE
         && (largest_block as f64) <= SPARSE_MAX_BLOCK_SHARE * unknowns as f64
+}
+
+/// The largest share of the dense LU's operations at which [`LinearSolver::Auto`] takes the
+/// bordered banded LU (`bordered_band.rs`).
+pub const BORDERED_MAX_SHARE: f64 = 0.2;
+
+/// The rule of [`LinearSolver::Auto`] for a system with banded blocks: the bordered banded LU
+/// when its operations are at most [`BORDERED_MAX_SHARE`] of the dense LU's.
+pub fn prefers_bordered(unknowns: usize, band: usize, width: usize) -> bool {
+    let dense = 2.0 / 3.0 * (unknowns as f64).powi(3);
+    BorderedBand::operations(band, width, unknowns - band) <= BORDERED_MAX_SHARE * dense
+}
+
+/// The unknowns a bordered banded LU eliminates first (the tails of the banded blocks, past
+/// their frame coordinates) and the largest half bandwidth; None without banded blocks.
+fn band_split(blocks: &BlockDiagonal) -> Option<(Vec<Range<usize>>, usize)> {
+    let mut width = 0;
+    let tails: Vec<Range<usize>> = blocks
+        .ranges
+        .iter()
+        .zip(&blocks.blocks)
+        .filter_map(|(r, b)| match b {
+            Block::Band(a) => {
+                width = width.max(a.width());
+                Some(r.start + a.head()..r.end)
+            }
+            Block::Dense(_) => None,
+        })
+        .collect();
+    (!tails.is_empty()).then_some((tails, width))
+}
+
+/// Visits (i, j, entry) of block b of d K_t + c_m M + c_c C_t over its stored entries.
+fn for_each_scaled(
+    mass: &Block,
+    kt: &Block,
+    ct: &Block,
+    w: Scaling,
+    with_tangents: bool,
+    mut visit: impl FnMut(usize, usize, f64),
+) {
+    mass.for_each_entry(|i, j, mm| {
+        let x = if with_tangents {
+            kt[(i, j)] * w.d + mm * w.cm + ct[(i, j)] * w.cc
+        } else {
+            mm * w.cm
+        };
+        visit(i, j, x);
+    });
 }
 
 /// The coefficients of the blocks: d K_t + c_m M + c_c C_t. With `d` and `c_c` zero the
@@ -78,6 +132,9 @@ pub struct IterationMatrix {
     cm: f64,
 }
 
+/// A dense matrix and its LU, where it is regular.
+type DenseLu = (DMatrix<f64>, Option<LU<f64, Dyn, Dyn>>);
+
 #[derive(Debug, Clone)]
 enum Factors {
     Dense {
@@ -85,6 +142,15 @@ enum Factors {
         lu: Option<LU<f64, Dyn, Dyn>>,
     },
     Sparse(Box<SparseLu>),
+    /// The bordered banded LU, and the dense LU it falls back to where it refuses.
+    Bordered {
+        band: Box<BorderedBand>,
+        dense: Option<Box<DenseLu>>,
+        /// Why the last factorization fell back, if it did.
+        refusal: Option<Refusal>,
+        /// Factorizations that fell back to the dense LU.
+        fallbacks: u64,
+    },
 }
 
 impl IterationMatrix {
@@ -94,6 +160,10 @@ impl IterationMatrix {
         let mass = sys.block_diagonal();
         let rows = sys.jacobian_pattern();
         let largest = mass.ranges.iter().map(|r| r.len()).max().unwrap_or(0);
+        let bordered = band_split(&mass).filter(|(tails, width)| {
+            let band = tails.iter().map(|r| r.len()).sum();
+            choice == LinearSolver::Auto && prefers_bordered(n + m, band, *width)
+        });
         let sparse = match choice {
             LinearSolver::Auto => prefers_sparse(n + m, largest),
             LinearSolver::Dense => false,
@@ -103,7 +173,14 @@ impl IterationMatrix {
             jac: DMatrix::zeros(n + m, n + m),
             lu: None,
         };
-        let factors = if sparse {
+        let factors = if let Some((tails, width)) = bordered {
+            Factors::Bordered {
+                band: Box::new(BorderedBand::new(n + m, &tails, width)),
+                dense: None,
+                refusal: None,
+                fallbacks: 0,
+            }
+        } else if sparse {
             // the symbolic analysis only fails when memory runs out: the dense LU then
             SparseLu::new(n, &mass, &rows).map_or_else(dense, |s| Factors::Sparse(Box::new(s)))
         } else {
@@ -127,6 +204,28 @@ impl IterationMatrix {
         matches!(self.factors, Factors::Sparse(_))
     }
 
+    /// Whether the bordered banded LU factorizes it (falling back to the dense LU where it
+    /// refuses).
+    pub fn is_bordered(&self) -> bool {
+        matches!(self.factors, Factors::Bordered { .. })
+    }
+
+    /// Factorizations the bordered banded LU refused and the dense LU did instead.
+    pub fn fallbacks(&self) -> u64 {
+        match &self.factors {
+            Factors::Bordered { fallbacks, .. } => *fallbacks,
+            _ => 0,
+        }
+    }
+
+    /// Why the bordered banded LU refused the last factorization (the dense LU did it).
+    pub fn refusal(&self) -> Option<Refusal> {
+        match &self.factors {
+            Factors::Bordered { refusal, .. } => *refusal,
+            _ => None,
+        }
+    }
+
     /// Whether factors are ready for [`IterationMatrix::solve_mut`].
     pub fn is_factored(&self) -> bool {
         self.factored
@@ -135,8 +234,14 @@ impl IterationMatrix {
     /// Drops the factors.
     pub fn forget(&mut self) {
         self.factored = false;
-        if let Factors::Dense { lu, .. } = &mut self.factors {
-            *lu = None;
+        match &mut self.factors {
+            Factors::Dense { lu, .. } => *lu = None,
+            Factors::Bordered { dense, .. } => {
+                if let Some(d) = dense {
+                    d.1 = None;
+                }
+            }
+            Factors::Sparse(_) => {}
         }
     }
 
@@ -145,6 +250,7 @@ impl IterationMatrix {
         match &self.factors {
             Factors::Dense { jac, .. } => jac.len(),
             Factors::Sparse(s) => s.values.len(),
+            Factors::Bordered { band, .. } => band.stored(),
         }
     }
 
@@ -158,32 +264,12 @@ impl IterationMatrix {
             sys.tangent_blocks(at, &mut self.kt, &mut self.ct);
         }
         sys.jacobian_rows(at.q, at.t, &mut self.rows);
-        let block = |kt: &DMatrix<f64>, mm: &DMatrix<f64>, ct: &DMatrix<f64>, i, j| {
-            if with_tangents {
-                kt[(i, j)] * w.d + mm[(i, j)] * w.cm + ct[(i, j)] * w.cc
-            } else {
-                mm[(i, j)] * w.cm
-            }
-        };
         let n = self.n;
         self.cm = w.cm;
+        let (mass, kt, ct, rows) = (&self.mass, &self.kt, &self.ct, &self.rows);
         self.factored = match &mut self.factors {
             Factors::Dense { jac, lu } => {
-                jac.fill(0.0);
-                for (b, r) in self.mass.ranges.iter().enumerate() {
-                    let (kt, mm, ct) =
-                        (&self.kt.blocks[b], &self.mass.blocks[b], &self.ct.blocks[b]);
-                    for j in 0..r.len() {
-                        for i in 0..r.len() {
-                            jac[(r.start + i, r.start + j)] = block(kt, mm, ct, i, j);
-                        }
-                    }
-                }
-                let g = self.rows.values();
-                self.rows.for_each_entry(|row, col, k| {
-                    jac[(n + row, col)] = g[k];
-                    jac[(col, n + row)] = g[k];
-                });
+                assemble_dense(jac, (mass, kt, ct), rows, w, with_tangents, n);
                 let f = jac.clone().lu();
                 let ok = f.is_invertible();
                 *lu = ok.then_some(f);
@@ -191,21 +277,57 @@ impl IterationMatrix {
             }
             Factors::Sparse(s) => {
                 let mut p = s.block_positions.iter();
-                for b in 0..self.mass.ranges.len() {
-                    let (kt, mm, ct) =
-                        (&self.kt.blocks[b], &self.mass.blocks[b], &self.ct.blocks[b]);
-                    for j in 0..mm.ncols() {
-                        for i in 0..mm.nrows() {
+                for b in 0..mass.ranges.len() {
+                    let (kt, mm, ct) = (&kt.blocks[b], &mass.blocks[b], &ct.blocks[b]);
+                    for j in 0..mm.n() {
+                        for i in 0..mm.n() {
                             let at = *p.next().expect("a position per block entry");
-                            s.values[at] = block(kt, mm, ct, i, j);
+                            s.values[at] = if with_tangents {
+                                kt[(i, j)] * w.d + mm[(i, j)] * w.cm + ct[(i, j)] * w.cc
+                            } else {
+                                mm[(i, j)] * w.cm
+                            };
                         }
                     }
                 }
-                for (x, [a, b]) in self.rows.values().iter().zip(&s.g_positions) {
+                for (x, [a, b]) in rows.values().iter().zip(&s.g_positions) {
                     s.values[*a] = *x;
                     s.values[*b] = *x;
                 }
                 s.factorize()
+            }
+            Factors::Bordered {
+                band,
+                dense,
+                refusal,
+                fallbacks,
+            } => {
+                band.clear();
+                for (b, r) in mass.ranges.iter().enumerate() {
+                    let (mm, k, c) = (&mass.blocks[b], &kt.blocks[b], &ct.blocks[b]);
+                    for_each_scaled(mm, k, c, w, with_tangents, |i, j, x| {
+                        band.set(r.start + i, r.start + j, x)
+                    });
+                }
+                let g = rows.values();
+                rows.for_each_entry(|row, col, k| {
+                    band.set(n + row, col, g[k]);
+                    band.set(col, n + row, g[k]);
+                });
+                *refusal = band.factorize().err();
+                if refusal.is_some() {
+                    // the dense LU, as LinearSolver::Dense would factorize it
+                    *fallbacks += 1;
+                    let dim = n + rows.nrows();
+                    let d = dense.get_or_insert_with(|| Box::new((DMatrix::zeros(dim, dim), None)));
+                    assemble_dense(&mut d.0, (mass, kt, ct), rows, w, with_tangents, n);
+                    let f = d.0.clone().lu();
+                    let ok = f.is_invertible();
+                    d.1 = ok.then_some(f);
+                    ok
+                } else {
+                    true
+                }
             }
         };
         self.factored
@@ -220,8 +342,8 @@ impl IterationMatrix {
         let n = self.n;
         rhs.fill(0.0);
         for (r, b) in self.mass.ranges.iter().zip(&self.mass.blocks) {
-            rhs.rows_mut(r.start, r.len())
-                .gemv(self.cm, b, &e.rows(r.start, r.len()), 0.0);
+            let x = &e.as_slice()[r.clone()];
+            b.gemv(self.cm, x, 0.0, &mut rhs.as_mut_slice()[r.clone()]);
         }
         let g = self.rows.values();
         self.rows
@@ -248,8 +370,46 @@ impl IterationMatrix {
                 s.solve_mut(rhs.as_mut_slice());
                 !finite || rhs.iter().all(|x| x.is_finite())
             }
+            Factors::Bordered {
+                band,
+                dense,
+                refusal,
+                ..
+            } => {
+                if refusal.is_some() {
+                    return dense
+                        .as_ref()
+                        .and_then(|d| d.1.as_ref())
+                        .is_some_and(|lu| lu.solve_mut(rhs));
+                }
+                let finite = rhs.iter().all(|x| x.is_finite());
+                band.solve_mut(rhs.as_mut_slice()) && (!finite || rhs.iter().all(|x| x.is_finite()))
+            }
         }
     }
+}
+
+/// Writes [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]] into `jac` (zeros elsewhere).
+fn assemble_dense(
+    jac: &mut DMatrix<f64>,
+    (mass, kt, ct): (&BlockDiagonal, &BlockDiagonal, &BlockDiagonal),
+    rows: &JacobianRows,
+    w: Scaling,
+    with_tangents: bool,
+    n: usize,
+) {
+    jac.fill(0.0);
+    for (b, r) in mass.ranges.iter().enumerate() {
+        let (mm, k, c) = (&mass.blocks[b], &kt.blocks[b], &ct.blocks[b]);
+        for_each_scaled(mm, k, c, w, with_tangents, |i, j, x| {
+            jac[(r.start + i, r.start + j)] = x
+        });
+    }
+    let g = rows.values();
+    rows.for_each_entry(|row, col, k| {
+        jac[(n + row, col)] = g[k];
+        jac[(col, n + row)] = g[k];
+    });
 }
 
 /// faer's sparse LU over the fixed pattern of the iteration matrix.

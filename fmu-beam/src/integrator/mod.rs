@@ -3,6 +3,7 @@
 //! output, consistent (re)starts and the byte codec of its state. Imports the mechanics' [`Equations`](crate::mechanics::Equations)
 //! and the layers below.
 
+pub(crate) mod bordered_band;
 pub(crate) mod codec;
 pub(crate) mod dense_output;
 pub(crate) mod generalized_alpha;

@@ -168,6 +168,9 @@ impl Equations for Mechanics {
     fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
         each!(self, s => Equations::mass_blocks(s, q, m))
     }
+    fn block_diagonal(&self) -> BlockDiagonal {
+        each!(self, s => Equations::block_diagonal(s))
+    }
     fn body_residual(
         &self,
         q: &DVector<f64>,

@@ -213,7 +213,7 @@ fn a_single_tangent_frame_gets_the_classical_floating_frame_damping() {
         let v = DVector::from_fn(q.len(), |_, _| noise.next());
         let f = force(&d, &v);
         let (frame, mff) = match &sys {
-            Mechanics::Planar(p) => (3, p.beam(0).unwrap().mff.clone()),
+            Mechanics::Planar(p) => (3, p.beam(0).unwrap().mff.to_dense()),
             Mechanics::Spatial(s, _) => match &s.bodies[0] {
                 crate::mechanics::Body3::Beam(b) => (7, b.mff.clone()),
                 _ => unreachable!(),

@@ -7,6 +7,7 @@
 mod common;
 
 mod beam_damping;
+mod bordered_iteration_matrix;
 mod input_inertia;
 mod planar_beam_element;
 mod planar_spatial_agreement;

@@ -152,7 +152,7 @@ fn quadratic_velocity_terms_follow_from_lagrange() {
         // remove the internal forces
         let f = z.rows(FLEX, b.nflex());
         let fd = zd.rows(FLEX, b.nflex());
-        let internal = &b.kff * f + &b.dff * fd;
+        let internal = b.kff.to_dense() * f + b.dff.to_dense() * fd;
         for k in 0..b.nflex() {
             h[FLEX + k] -= internal[k];
         }

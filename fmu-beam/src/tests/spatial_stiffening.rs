@@ -93,7 +93,7 @@ fn stiffening_energy_is_the_planar_one_in_either_plane_and_adds_up_in_both() {
             let mut z = DVector::zeros(PFLEX + n);
             z.rows_mut(PFLEX, n).copy_from(q);
             let full = p.strain_energy(&z);
-            (full, full - 0.5 * q.dot(&(&p.kff * q)))
+            (full, full - 0.5 * q.dot(&p.kff.mul_vec(&q.as_view())))
         };
         let spatial = |f: &DVector<f64>| {
             let full = s.strain_energy(f);

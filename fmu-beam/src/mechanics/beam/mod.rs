@@ -3,6 +3,7 @@
 //! built from its own numbers and [`FloatingFrame`]; `mechanics/from_scene/` turns a scene's
 //! entries into them.
 
+pub(crate) mod band;
 pub(crate) mod planar_beam;
 pub(crate) mod planar_element;
 pub(crate) mod section;

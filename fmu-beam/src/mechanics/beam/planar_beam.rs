@@ -10,10 +10,11 @@
 //! r(z, ż, z̈) = M(z) z̈ + h(z, ż) + [0; 0; K_ff q_f + D_ff q̇_f] - Q_g(z)
 //! with M = ∫ρ Lᵀ L, L = ∂r/∂z = [I, A_θ ū, A S], and h the quadratic-velocity vector.
 
+use super::band::{Banded, BlockMut};
 use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
 use super::FloatingFrame;
-use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Matrix2, Vector2};
+use nalgebra::{DMatrix, DVector, DVectorView, Matrix2, Vector2};
 use std::cell::Cell;
 
 mod build;
@@ -164,13 +165,13 @@ pub struct PlanarBeam {
     /// b = ∫ρ (ū0₁ S₂ - ū0₂ S₁) dV, the constant part of Ī_θf.
     pub b: DVector<f64>,
     /// m_ff = ∫ρ SᵀS dV.
-    pub mff: DMatrix<f64>,
+    pub mff: Banded,
     /// W = ∫ρ (S₁ᵀS₂ - S₂ᵀS₁) dV (skew): Ī_θf = b + Wᵀ q_f.
-    pub w: DMatrix<f64>,
+    pub w: Banded,
     /// K_ff, the linear stiffness matrix over the kept coordinates.
-    pub kff: DMatrix<f64>,
+    pub kff: Banded,
     /// D_ff = β K_ff, the stiffness-proportional Rayleigh damping on the strain rates.
-    pub dff: DMatrix<f64>,
+    pub dff: Banded,
     /// Flange a: the material point at the root (x = 0).
     pub flange_a: PointMap,
     /// Flange b: the material point at the tip (x = length).
@@ -187,6 +188,8 @@ pub struct PlanarBeam {
     /// have a nonzero entry: the element matrices are assembled into a band, so the products
     /// of each evaluation skip the zeros (bit for bit the same sums).
     band: Vec<std::ops::Range<usize>>,
+    /// Reduced index of each full nodal coordinate (3 per node), where kept.
+    kept_index: Vec<Option<usize>>,
     /// The element's slope rows at the Gauss points and ⟨v'_q v'_qᵀ⟩, constant per beam.
     strain: StrainRows,
 }
@@ -230,7 +233,30 @@ impl PlanarBeam {
 
     /// Reduced index of the full nodal coordinate `full`, if the boundary conditions keep it.
     pub fn flex_index(&self, full: usize) -> Option<usize> {
-        self.kept.iter().position(|&k| k == full)
+        self.kept_index.get(full).copied().flatten()
+    }
+
+    /// Half bandwidth of the deformation block of M, K_t and C_t (its coordinates couple only
+    /// within an element); None under modal truncation, whose block is dense.
+    pub fn band_width(&self) -> Option<usize> {
+        if self.basis.is_some() {
+            return None;
+        }
+        let within = self.band.iter().enumerate();
+        let matrices = within.fold(0, |w, (k, r)| {
+            w.max(k.saturating_sub(r.start))
+                .max(r.end.saturating_sub(k + 1))
+        });
+        let elements = (0..self.elements).fold(0, |w, j| {
+            let idx = (0..ELEMENT_DOFS).filter_map(|p| self.flex_index(3 * j + p));
+            let (lo, hi) = idx.fold((usize::MAX, 0), |(lo, hi), k| (lo.min(k), hi.max(k)));
+            if lo <= hi {
+                w.max(hi - lo)
+            } else {
+                w
+            }
+        });
+        Some(matrices.max(elements))
     }
 
     /// First moment c = ∫ρ ū dV = S̄_t0 + S̄ q_f in the beam frame.
@@ -248,14 +274,14 @@ impl PlanarBeam {
     }
 
     /// Mass matrix M(z), written into `m` (ndof × ndof).
-    pub fn mass_matrix<'a>(&self, z: impl Coords<'a>, mut m: DMatrixViewMut<f64>) {
+    pub fn mass_matrix<'a, B: BlockMut>(&self, z: impl Coords<'a>, mut m: B) {
         let z = z.into();
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
         let (ar, ath) = rot(z[THETA]);
         let c = self.first_moment(&f);
         let athc = ath * c;
-        m.fill(0.0);
+        m.set_zero();
         m[(0, 0)] = self.mass;
         m[(1, 1)] = self.mass;
         for i in 0..2 {
@@ -280,7 +306,11 @@ impl PlanarBeam {
             m[(FLEX + k, THETA)] = mthf;
         }
         m[(THETA, THETA)] = mthth;
-        m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);
+        for k in 0..nf {
+            for l in self.band[k].clone() {
+                m[(FLEX + k, FLEX + l)] = self.mff[(k, l)];
+            }
+        }
     }
 
     /// Residual r = M z̈ + h + internal - gravity, added into `r`. Gravity is `None` when the
@@ -383,14 +413,14 @@ impl PlanarBeam {
 
     /// Tangents of the residual: K_t = ∂r/∂z (at fixed ż, z̈) and C_t = ∂r/∂ż, added into the
     /// given blocks (ndof × ndof).
-    pub fn tangents<'a>(
+    pub fn tangents<'a, B: BlockMut>(
         &self,
         z: impl Coords<'a>,
         zd: impl Coords<'a>,
         zdd: impl Coords<'a>,
         gravity: Option<Vector2<f64>>,
-        mut kt: DMatrixViewMut<f64>,
-        mut ct: DMatrixViewMut<f64>,
+        mut kt: B,
+        mut ct: B,
     ) {
         let (qv, damping) = (self.options.quadratic_velocity, self.options.damping);
         self.count_terms(gravity.is_some());
@@ -476,8 +506,11 @@ impl PlanarBeam {
             }
         }
         if damping {
-            let mut c = ct.view_mut((FLEX, FLEX), (nf, nf));
-            c += &self.dff;
+            for k in 0..nf {
+                for l in self.band[k].clone() {
+                    ct[(FLEX + k, FLEX + l)] += self.dff[(k, l)];
+                }
+            }
         }
         if self.geometric_stiffening {
             self.stiffening_tangent(&z, &mut kt);
@@ -505,7 +538,7 @@ impl PlanarBeam {
         } else {
             0.0
         };
-        0.5 * f.dot(&(&self.kff * f)) + extra
+        0.5 * f.dot(&self.kff.mul_vec(&f)) + extra
     }
 
     /// Potential energy of gravity -g·∫ρ r dV (J).
@@ -572,7 +605,7 @@ impl PlanarBeam {
         if load.amax() == 0.0 {
             return None; // the frame holds the tip
         }
-        let q = self.kff.clone().lu().solve(&load)?;
+        let q = self.kff.to_dense().lu().solve(&load)?;
         let scale = tip / load.dot(&q);
         scale.is_finite().then(|| q * scale)
     }

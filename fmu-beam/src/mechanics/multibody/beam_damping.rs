@@ -135,7 +135,7 @@ impl BeamDamping {
             .collect();
         for (j, b) in self.bodies.iter().enumerate() {
             let n = b.mass.nrows();
-            let mut block = ct.blocks[b.body].view_mut((0, 0), (n, n));
+            let mut block = ct.blocks[b.body].dense_mut().view_mut((0, 0), (n, n));
             match &b.reference {
                 None => block += &b.mass * self.alpha,
                 Some(sj) => {

@@ -5,8 +5,9 @@
 //! building them: joints and loads only need J_pᵀ w + J_φ c for a world vector w and a scalar c.
 
 use super::body::Body;
+use crate::mechanics::beam::band::BlockMut;
 use crate::mechanics::beam::planar_beam::{rot, PointMap, FLEX, THETA};
-use nalgebra::{DMatrixViewMut, DVectorView, Matrix2, Vector2};
+use nalgebra::{DVectorView, Matrix2, Vector2};
 
 /// Where a frame sits.
 #[derive(Debug, Clone)]
@@ -114,12 +115,12 @@ impl<'a> FrameState<'a> {
 
 /// Adds ∂(J_pᵀ F)/∂z for a world force F held constant, into `k` (ndof × ndof):
 /// the tangent of a reaction or load applied at the frame.
-pub fn add_force_tangent(
+pub fn add_force_tangent<B: BlockMut>(
     body: &Body,
     map: &PointMap,
     z: DVectorView<f64>,
     force: Vector2<f64>,
-    mut k: DMatrixViewMut<f64>,
+    k: &mut B,
 ) {
     let nf = body.nflex();
     let (ar, ath) = rot(z[THETA]);

@@ -14,5 +14,5 @@ pub(crate) mod system;
 pub(crate) mod weld;
 
 pub use equations::{CoordinateKind, Equations, Point, Turning};
-pub use sparsity::{BlockDiagonal, JacobianRows};
+pub use sparsity::{Block, BlockDiagonal, JacobianRows};
 pub use system::System;

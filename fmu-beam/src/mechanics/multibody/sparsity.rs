@@ -1,43 +1,127 @@
 //! The sparsity of a multibody system's matrices, fixed when the system is built: M, K_t and C_t
-//! are block diagonal over the bodies' coordinates ([`BlockDiagonal`]), and each constraint row
+//! are block diagonal over the bodies' coordinates ([`BlockDiagonal`]; a beam's block may be an
+//! arrow band, `beam/band.rs`), and each constraint row
 //! depends on the coordinates of at most two bodies, the bodies of its joint's frames
 //! ([`JacobianRows`]). Work on them is O(Σ block² + nnz(G)) instead of O(n²) and O(m n).
 
+use crate::mechanics::beam::band::ArrowBand;
 use nalgebra::{DMatrix, DVector};
-use std::ops::Range;
+use std::ops::{Index, Range};
 
-/// A block-diagonal matrix: one dense block per body, over the body's coordinates in q.
+/// One body's block: dense, or an arrow band (a beam's frame coordinates around the band of
+/// its deformation coordinates).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Block {
+    Dense(DMatrix<f64>),
+    Band(ArrowBand),
+}
+
+impl Block {
+    /// Order of the block.
+    pub fn n(&self) -> usize {
+        match self {
+            Block::Dense(d) => d.nrows(),
+            Block::Band(b) => b.n(),
+        }
+    }
+
+    pub fn fill_zero(&mut self) {
+        match self {
+            Block::Dense(d) => d.fill(0.0),
+            Block::Band(b) => b.fill_zero(),
+        }
+    }
+
+    /// The dense matrix of a block that bodies fill densely (rigid bodies, 3D bodies);
+    /// panics on a banded block.
+    pub fn dense_mut(&mut self) -> &mut DMatrix<f64> {
+        match self {
+            Block::Dense(d) => d,
+            Block::Band(b) => panic!(
+                "a banded block (order {}, half bandwidth {}) written as a dense one",
+                b.n(),
+                b.width()
+            ),
+        }
+    }
+
+    /// Visits (i, j, value) of every stored entry.
+    pub fn for_each_entry(&self, mut visit: impl FnMut(usize, usize, f64)) {
+        match self {
+            Block::Dense(d) => {
+                for j in 0..d.ncols() {
+                    for i in 0..d.nrows() {
+                        visit(i, j, d[(i, j)]);
+                    }
+                }
+            }
+            Block::Band(b) => b.for_each_entry(visit),
+        }
+    }
+
+    /// y = α B x + β y.
+    pub fn gemv(&self, alpha: f64, x: &[f64], beta: f64, y: &mut [f64]) {
+        match self {
+            Block::Dense(d) => {
+                let mut yv = nalgebra::DVectorViewMut::from_slice(y, d.nrows());
+                yv.gemv(
+                    alpha,
+                    d,
+                    &nalgebra::DVectorView::from_slice(x, d.ncols()),
+                    beta,
+                );
+            }
+            Block::Band(b) => b.gemv(alpha, x, beta, y),
+        }
+    }
+}
+
+impl Index<(usize, usize)> for Block {
+    type Output = f64;
+    fn index(&self, ij: (usize, usize)) -> &f64 {
+        match self {
+            Block::Dense(d) => &d[ij],
+            Block::Band(b) => &b[ij],
+        }
+    }
+}
+
+/// A block-diagonal matrix: one block per body, over the body's coordinates in q.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlockDiagonal {
     /// Coordinates of each block (consecutive, covering 0..n).
     pub ranges: Vec<Range<usize>>,
-    pub blocks: Vec<DMatrix<f64>>,
+    pub blocks: Vec<Block>,
 }
 
 impl BlockDiagonal {
-    /// Zero blocks over `ranges`.
+    /// Zero dense blocks over `ranges`.
     pub fn zeros(ranges: &[Range<usize>]) -> BlockDiagonal {
         BlockDiagonal {
             ranges: ranges.to_vec(),
             blocks: ranges
                 .iter()
-                .map(|r| DMatrix::zeros(r.len(), r.len()))
+                .map(|r| Block::Dense(DMatrix::zeros(r.len(), r.len())))
                 .collect(),
         }
     }
 
     pub fn fill_zero(&mut self) {
         for b in &mut self.blocks {
-            b.fill(0.0);
+            b.fill_zero();
         }
+    }
+
+    /// Whether any block is banded.
+    pub fn has_band(&self) -> bool {
+        self.blocks.iter().any(|b| matches!(b, Block::Band(_)))
     }
 
     /// Writes the whole n × n matrix (zeros off the blocks) into `out`.
     pub fn to_dense(&self, out: &mut DMatrix<f64>) {
         out.fill(0.0);
         for (r, b) in self.ranges.iter().zip(&self.blocks) {
-            out.view_mut((r.start, r.start), (r.len(), r.len()))
-                .copy_from(b);
+            b.for_each_entry(|i, j, x| out[(r.start + i, r.start + j)] = x);
         }
     }
 }

@@ -9,10 +9,11 @@ use super::frame::{self, Frame, FrameState};
 use super::joint::{DriveKind, Joint, JointKind, Rows};
 use super::law::{InputValue, TimeLaw};
 use super::rigid_body::RigidBody;
-use super::sparsity::{BlockDiagonal, JacobianRows};
+use super::sparsity::{Block, BlockDiagonal, JacobianRows};
 use crate::error::EngineError;
-use crate::mechanics::beam::planar_beam::TermCounts;
+use crate::mechanics::beam::band::ArrowBand;
 use crate::mechanics::beam::planar_beam::{rot, PlanarBeam, PointMap, THETA};
+use crate::mechanics::beam::planar_beam::{TermCounts, FLEX};
 use crate::mechanics::Effects;
 use nalgebra::{DVector, DVectorView, Vector2};
 use std::ops::Range;
@@ -256,13 +257,13 @@ impl System {
         if let Frame::OnBody { body, map } = &self.frames[frame] {
             let b = &self.bodies[*body];
             let n = b.ndof();
-            frame::add_force_tangent(
-                b,
-                map,
-                self.body_coords(*body, q),
-                force,
-                kt.blocks[*body].view_mut((0, 0), (n, n)),
-            );
+            let z = self.body_coords(*body, q);
+            match &mut kt.blocks[*body] {
+                Block::Band(k) => frame::add_force_tangent(b, map, z, force, &mut k.as_mut()),
+                Block::Dense(k) => {
+                    frame::add_force_tangent(b, map, z, force, &mut k.view_mut((0, 0), (n, n)))
+                }
+            }
         }
     }
 
@@ -412,8 +413,28 @@ impl super::equations::Equations for System {
         m.fill_zero();
         for (i, b) in self.bodies.iter().enumerate() {
             let n = b.ndof();
-            b.mass_matrix(self.body_coords(i, q), m.blocks[i].view_mut((0, 0), (n, n)));
+            let z = self.body_coords(i, q);
+            match (b, &mut m.blocks[i]) {
+                (Body::Beam(beam), Block::Band(band)) => beam.mass_matrix(z, band.as_mut()),
+                (_, block) => b.mass_matrix(z, block.dense_mut().view_mut((0, 0), (n, n))),
+            }
         }
+    }
+    /// Dense blocks, but an arrow band for a beam whose deformation block is wider than its
+    /// band (`beam/band.rs`) and whose damping adds no dense block (mass-proportional α).
+    fn block_diagonal(&self) -> BlockDiagonal {
+        let mut d = BlockDiagonal::zeros(&self.body_ranges());
+        for (i, b) in self.bodies.iter().enumerate() {
+            let Body::Beam(beam) = b else { continue };
+            let dense_damping = beam.options.damping && beam.rayleigh_alpha != 0.0;
+            match beam.band_width() {
+                Some(w) if !dense_damping && 2 * w + 1 < beam.nflex() => {
+                    d.blocks[i] = Block::Band(ArrowBand::zeros(beam.ndof(), FLEX, w));
+                }
+                _ => {}
+            }
+        }
+        d
     }
     /// Residual r(q, q', q'', t) without the reactions: inertia + internal - applied, overwritten.
     fn body_residual(
@@ -465,14 +486,24 @@ impl super::equations::Equations for System {
         ct.fill_zero();
         for (i, b) in self.bodies.iter().enumerate() {
             let n = b.ndof();
-            b.tangents(
+            let (z, zd, zdd) = (
                 self.body_coords(i, q),
                 self.body_coords(i, v),
                 self.body_coords(i, a),
-                self.gravity,
-                kt.blocks[i].view_mut((0, 0), (n, n)),
-                ct.blocks[i].view_mut((0, 0), (n, n)),
             );
+            match (b, &mut kt.blocks[i], &mut ct.blocks[i]) {
+                (Body::Beam(beam), Block::Band(k), Block::Band(c)) => {
+                    beam.tangents(z, zd, zdd, self.gravity, k.as_mut(), c.as_mut())
+                }
+                (_, k, c) => b.tangents(
+                    z,
+                    zd,
+                    zdd,
+                    self.gravity,
+                    k.dense_mut().view_mut((0, 0), (n, n)),
+                    c.dense_mut().view_mut((0, 0), (n, n)),
+                ),
+            }
         }
         for g in 0..self.beams.len() {
             if let Some(d) = self.beam_damping(g, q) {

@@ -628,7 +628,9 @@ impl Equations for System3 {
 
     fn mass_blocks(&self, q: &DVector<f64>, m: &mut BlockDiagonal) {
         for (i, b) in self.bodies.iter().enumerate() {
-            m.blocks[i].copy_from(&b.mass_matrix(self.body_coords(i, q)));
+            m.blocks[i]
+                .dense_mut()
+                .copy_from(&b.mass_matrix(self.body_coords(i, q)));
         }
     }
 
@@ -673,7 +675,7 @@ impl Equations for System3 {
         let g = self.gravity.unwrap_or_default();
         for (i, b) in self.bodies.iter().enumerate() {
             let n = b.ncoords();
-            let kb = &mut kt.blocks[i];
+            let kb = kt.blocks[i].dense_mut();
             b.tangents(
                 self.body_coords(i, q),
                 self.body_coords(i, v),
@@ -681,7 +683,7 @@ impl Equations for System3 {
                 &g,
                 EPS_FORWARD,
                 kb.view_mut((0, 0), (n, n)),
-                ct.blocks[i].view_mut((0, 0), (n, n)),
+                ct.blocks[i].dense_mut().view_mut((0, 0), (n, n)),
             );
             for k in 0..4 {
                 kb[(3 + k, 3 + k)] += 2.0 * lambda[i];

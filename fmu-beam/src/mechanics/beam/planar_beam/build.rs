@@ -3,6 +3,7 @@
 //! conditions and the options applied (no axial coordinates, band structure, modal truncation).
 
 use super::*;
+use crate::mechanics::beam::band::Banded;
 
 impl PlanarBeam {
     /// The full model: the terms of [`BeamOptions::default`] (all but geometric stiffening),
@@ -58,13 +59,11 @@ impl PlanarBeam {
         let mu = rho * section.area;
         let ea = e * section.area;
         let ej = e * section.second_moment;
-        let full = full_integrals(length, elements, mu, ea, ej);
+        let index = kept_index(&kept);
+        let full = kept_integrals(length, elements, mu, ea, ej, &index, kept.len());
         let pick_cols = |m: &DMatrix<f64>| m.select_columns(kept.iter());
-        let pick = |m: &DMatrix<f64>| m.select_rows(kept.iter()).select_columns(kept.iter());
         let pick_v = |v: &DVector<f64>| v.select_rows(kept.iter());
-        let mff = pick(&full.mff);
-        let kff = pick(&full.kff);
-        let dff = &kff * rayleigh_beta;
+        let dff = full.kff.scaled(rayleigh_beta);
         let mass = mu * length;
         let node_map = |node: usize, x: f64| {
             let mut sp_full = DMatrix::zeros(2, n_full);
@@ -92,15 +91,16 @@ impl PlanarBeam {
             mass,
             st0: Vector2::new(mass * length / 2.0, 0.0),
             i0: mass * length * length / 3.0,
-            sbar: pick_cols(&full.sbar),
-            a: pick_v(&full.a),
-            b: pick_v(&full.b),
-            w: pick(&full.w),
-            mff,
-            kff,
+            sbar: full.sbar,
+            a: full.a,
+            b: full.b,
+            w: full.w,
+            mff: full.mff,
+            kff: full.kff,
             dff,
             flange_a: node_map(0, 0.0),
             flange_b: node_map(elements, length),
+            kept_index: index,
             kept,
             geometric_stiffening: options.geometric_stiffening,
             options,
@@ -121,6 +121,21 @@ impl PlanarBeam {
     /// The beam with its [`PlanarBeam::band`] found from its matrices.
     pub(super) fn banded(mut self) -> PlanarBeam {
         let nf = self.mff.nrows();
+        // without truncation a coordinate's entries lie within the elements of its node
+        let window = |k: usize| match self.basis {
+            Some(_) => 0..nf,
+            None => {
+                let node = self.kept[k] / 3;
+                let first = (3 * node.saturating_sub(1)..3 * node + 6)
+                    .find_map(|f| self.flex_index(f))
+                    .unwrap_or(k);
+                let last = (3 * node.saturating_sub(1)..3 * node + 6)
+                    .rev()
+                    .find_map(|f| self.flex_index(f))
+                    .unwrap_or(k);
+                first..last + 1
+            }
+        };
         self.band = (0..nf)
             .map(|k| {
                 let nonzero = |l: usize| {
@@ -131,8 +146,8 @@ impl PlanarBeam {
                         || self.kff[(k, l)] != 0.0
                         || self.dff[(k, l)] != 0.0
                 };
-                let lo = (0..nf).find(|&l| nonzero(l)).unwrap_or(k);
-                let hi = (0..nf).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
+                let lo = window(k).find(|&l| nonzero(l)).unwrap_or(k);
+                let hi = window(k).rev().find(|&l| nonzero(l)).map_or(k, |l| l + 1);
                 lo..hi.max(lo)
             })
             .collect();
@@ -142,15 +157,15 @@ impl PlanarBeam {
     /// The beam on the lowest `k` modes of (K_ff, M_ff): q_nodal = Φ q_f with Φᵀ M_ff Φ = I, so
     /// every constant of eq. (11) becomes its projection (S̄ Φ, Φᵀ a, Φᵀ W Φ, ...).
     pub(super) fn truncated(mut self, k: usize) -> PlanarBeam {
-        let phi = lowest_modes(&self.kff, &self.mff, k);
+        let phi = lowest_modes(&self.kff.to_dense(), &self.mff.to_dense(), k);
         let pt = phi.transpose();
         self.sbar = &self.sbar * &phi;
         self.a = &pt * &self.a;
         self.b = &pt * &self.b;
-        self.w = &pt * &self.w * &phi;
-        self.mff = &pt * &self.mff * &phi;
-        self.kff = &pt * &self.kff * &phi;
-        self.dff = &self.kff * self.rayleigh_beta;
+        self.w = Banded::from_dense(&(&pt * self.w.to_dense() * &phi));
+        self.mff = Banded::from_dense(&(&pt * self.mff.to_dense() * &phi));
+        self.kff = Banded::from_dense(&(&pt * self.kff.to_dense() * &phi));
+        self.dff = self.kff.scaled(self.rayleigh_beta);
         for map in [&mut self.flange_a, &mut self.flange_b] {
             reduce_map(map, &phi);
         }
@@ -159,55 +174,71 @@ impl PlanarBeam {
     }
 }
 
-/// Full-beam integrals before the boundary conditions remove coordinates.
-pub(super) struct FullIntegrals {
+/// The beam's integrals over the coordinates the boundary conditions keep.
+pub(super) struct KeptIntegrals {
     sbar: DMatrix<f64>,
     a: DVector<f64>,
     b: DVector<f64>,
-    mff: DMatrix<f64>,
-    w: DMatrix<f64>,
-    kff: DMatrix<f64>,
+    mff: Banded,
+    w: Banded,
+    kff: Banded,
 }
 
-/// Integrals of eq. (11) over all N elements, before boundary conditions (eq. (8)–(12)).
-pub(super) fn full_integrals(
+/// Integrals of eq. (11) over all N elements (eq. (8)–(12)), each element's entries added
+/// only where the boundary conditions keep both coordinates (`index`: the kept index of each
+/// full nodal coordinate, `nk` kept): the full matrices never exist, so the set-up stays
+/// linear in the elements apart from zeroing the dense n_k × n_k storage.
+pub(super) fn kept_integrals(
     length: f64,
     elements: usize,
     mu: f64,
     ea: f64,
     ej: f64,
-) -> FullIntegrals {
-    let n_full = 3 * (elements + 1);
+    index: &[Option<usize>],
+    nk: usize,
+) -> KeptIntegrals {
     let l = length / elements as f64;
-    let mut out = FullIntegrals {
-        sbar: DMatrix::zeros(2, n_full),
-        a: DVector::zeros(n_full),
-        b: DVector::zeros(n_full),
-        mff: DMatrix::zeros(n_full, n_full),
-        w: DMatrix::zeros(n_full, n_full),
-        kff: DMatrix::zeros(n_full, n_full),
+    let of_element =
+        |j: usize| (0..ELEMENT_DOFS).filter_map(move |p| index.get(3 * j + p).copied().flatten());
+    let width = (0..elements)
+        .filter_map(|j| Some(of_element(j).max()? - of_element(j).min()?))
+        .max()
+        .unwrap_or(0);
+    let mut out = KeptIntegrals {
+        sbar: DMatrix::zeros(2, nk),
+        a: DVector::zeros(nk),
+        b: DVector::zeros(nk),
+        mff: Banded::zeros(nk, width),
+        w: Banded::zeros(nk, width),
+        kff: Banded::zeros(nk, width),
     };
     let ke = planar_element::stiffness(ea, ej, l);
     for j in 0..elements {
-        let o = 3 * j; // the connectivity matrix B_j of eq. (9)
+        // the connectivity matrix B_j of eq. (9), then the boundary conditions
+        let idx: [Option<usize>; ELEMENT_DOFS] =
+            std::array::from_fn(|p| index.get(3 * j + p).copied().flatten());
         for &(xi, wgt) in &GAUSS_4 {
             let (s1, s2) = planar_element::shape(xi, l);
             let dm = mu * l * wgt;
             let x0 = (j as f64 + xi) * l;
             for p in 0..ELEMENT_DOFS {
-                out.sbar[(0, o + p)] += dm * s1[p];
-                out.sbar[(1, o + p)] += dm * s2[p];
-                out.a[o + p] += dm * s1[p] * x0;
-                out.b[o + p] += dm * s2[p] * x0;
+                let Some(kp) = idx[p] else { continue };
+                out.sbar[(0, kp)] += dm * s1[p];
+                out.sbar[(1, kp)] += dm * s2[p];
+                out.a[kp] += dm * s1[p] * x0;
+                out.b[kp] += dm * s2[p] * x0;
                 for q in 0..ELEMENT_DOFS {
-                    out.mff[(o + p, o + q)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
-                    out.w[(o + p, o + q)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
+                    let Some(kq) = idx[q] else { continue };
+                    out.mff[(kp, kq)] += dm * (s1[p] * s1[q] + s2[p] * s2[q]);
+                    out.w[(kp, kq)] += dm * (s1[p] * s2[q] - s2[p] * s1[q]);
                 }
             }
         }
         for p in 0..ELEMENT_DOFS {
+            let Some(kp) = idx[p] else { continue };
             for q in 0..ELEMENT_DOFS {
-                out.kff[(o + p, o + q)] += ke[p][q];
+                let Some(kq) = idx[q] else { continue };
+                out.kff[(kp, kq)] += ke[p][q];
             }
         }
     }
@@ -236,4 +267,13 @@ pub fn lowest_modes(kff: &DMatrix<f64>, mff: &DMatrix<f64>, k: usize) -> DMatrix
         .map(|&i| linv.tr_mul(&eig.eigenvectors.column(i).into_owned()))
         .collect();
     DMatrix::from_columns(&cols)
+}
+
+/// Reduced index of each full nodal coordinate, where kept.
+fn kept_index(kept: &[usize]) -> Vec<Option<usize>> {
+    let mut index = vec![None; kept.iter().max().map_or(0, |&k| k + 1)];
+    for (k, &f) in kept.iter().enumerate() {
+        index[f] = Some(k);
+    }
+    index
 }

@@ -81,27 +81,31 @@ impl PlanarBeam {
         }
     }
 
-    /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ).
-    pub(super) fn stiffening_tangent(&self, z: &DVectorView<f64>, kt: &mut DMatrixViewMut<f64>) {
+    /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ),
+    /// element by element into `kt` (through the modes under truncation).
+    pub(super) fn stiffening_tangent<B: BlockMut>(&self, z: &DVectorView<f64>, kt: &mut B) {
         let ea = self.ea;
         let fq = self.nodal(z);
-        let nk = self.kept.len();
-        let mut nodal = DMatrix::zeros(nk, nk);
+        let mut nodal = self.basis.as_ref().map(|_| {
+            let nk = self.kept.len();
+            DMatrix::zeros(nk, nk)
+        });
         self.for_element_strains(&fq, |idx, l, eps, de, hv| {
             let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 let Some(kp) = idx[p] else { continue };
                 for r in 0..ELEMENT_DOFS {
                     let Some(kr) = idx[r] else { continue };
-                    nodal[(kp, kr)] += ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
+                    let x = ea * l * (de[p] * de[r] + eps * hv[p][r] - da[p] * da[r]);
+                    match &mut nodal {
+                        Some(m) => m[(kp, kr)] += x,
+                        None => kt[(FLEX + kp, FLEX + kr)] += x,
+                    }
                 }
             }
         });
-        let nf = self.nflex();
-        let mut block = kt.view_mut((FLEX, FLEX), (nf, nf));
-        match &self.basis {
-            Some(phi) => block += phi.tr_mul(&nodal) * phi,
-            None => block += nodal,
+        if let (Some(phi), Some(nodal)) = (&self.basis, nodal) {
+            add_block(kt, &(phi.tr_mul(&nodal) * phi));
         }
     }
 
@@ -173,36 +177,53 @@ impl PlanarBeam {
     }
 
     /// Tangents of [`Self::stiffening_damping`]: ∂/∂ḟ = β EA ℓ (∂ε ∂εᵀ − ∂u' ∂u'ᵀ) into `ct`,
-    /// ∂/∂f = β EA ℓ (∂ε (H ḟ)ᵀ + ε̇ H) into `kt`.
-    pub(super) fn stiffening_damping_tangents(
+    /// ∂/∂f = β EA ℓ (∂ε (H ḟ)ᵀ + ε̇ H) into `kt`, element by element (through the modes
+    /// under truncation).
+    pub(super) fn stiffening_damping_tangents<B: BlockMut>(
         &self,
         z: &DVectorView<f64>,
         zd: &DVectorView<f64>,
-        kt: &mut DMatrixViewMut<f64>,
-        ct: &mut DMatrixViewMut<f64>,
+        kt: &mut B,
+        ct: &mut B,
     ) {
         let c = self.rayleigh_beta * self.ea;
-        let nk = self.kept.len();
-        let (mut dk, mut dc) = (DMatrix::zeros(nk, nk), DMatrix::zeros(nk, nk));
+        let mut nodal = self.basis.as_ref().map(|_| {
+            let nk = self.kept.len();
+            (DMatrix::zeros(nk, nk), DMatrix::zeros(nk, nk))
+        });
         self.for_element_strain_rates(z, zd, |idx, l, eps_dot, _, de, h_qd, hv| {
             let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
             for p in 0..ELEMENT_DOFS {
                 let Some(kp) = idx[p] else { continue };
                 for r in 0..ELEMENT_DOFS {
                     let Some(kr) = idx[r] else { continue };
-                    dc[(kp, kr)] += c * l * (de[p] * de[r] - da[p] * da[r]);
-                    dk[(kp, kr)] += c * l * (de[p] * h_qd[r] + eps_dot * hv[p][r]);
+                    let xc = c * l * (de[p] * de[r] - da[p] * da[r]);
+                    let xk = c * l * (de[p] * h_qd[r] + eps_dot * hv[p][r]);
+                    match &mut nodal {
+                        Some((dk, dc)) => {
+                            dc[(kp, kr)] += xc;
+                            dk[(kp, kr)] += xk;
+                        }
+                        None => {
+                            ct[(FLEX + kp, FLEX + kr)] += xc;
+                            kt[(FLEX + kp, FLEX + kr)] += xk;
+                        }
+                    }
                 }
             }
         });
-        let nf = self.nflex();
-        let reduced = |m: DMatrix<f64>| match &self.basis {
-            Some(phi) => phi.tr_mul(&m) * phi,
-            None => m,
-        };
-        let mut block = kt.view_mut((FLEX, FLEX), (nf, nf));
-        block += reduced(dk);
-        let mut block = ct.view_mut((FLEX, FLEX), (nf, nf));
-        block += reduced(dc);
+        if let (Some(phi), Some((dk, dc))) = (&self.basis, nodal) {
+            add_block(kt, &(phi.tr_mul(&dk) * phi));
+            add_block(ct, &(phi.tr_mul(&dc) * phi));
+        }
+    }
+}
+
+/// Adds a dense deformation block (nf × nf) into a body block from [`FLEX`] on.
+fn add_block<B: BlockMut>(to: &mut B, block: &DMatrix<f64>) {
+    for l in 0..block.ncols() {
+        for k in 0..block.nrows() {
+            to[(FLEX + k, FLEX + l)] += block[(k, l)];
+        }
     }
 }
