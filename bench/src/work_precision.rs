@@ -27,6 +27,7 @@ use cases::{Case, Formulation, Reference};
 use fmu_beam::scene::EffectsSpec;
 use fmu_beam::{resolve_effects as resolve, EFFECTS};
 use fmu_beam::{Engine, EngineError, Scene};
+use fmu_harness::accuracy::thread_cpu_seconds;
 use std::path::Path;
 use std::time::Instant;
 
@@ -157,18 +158,6 @@ struct Series {
     missing: Vec<String>,
     seconds: f64,
     stats: [i64; 3],
-}
-
-/// CPU seconds this thread has run, from the scheduler's account; None where Linux does not
-/// offer it.
-fn thread_cpu_seconds() -> Option<f64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse::<f64>()
-        .ok()
-        .map(|ns| ns * 1e-9)
 }
 
 /// Simulates `scene` (already at its integrator setting) over the case's communication grid.

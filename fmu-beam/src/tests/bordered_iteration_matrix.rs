@@ -5,15 +5,12 @@
 //! pivots goes to the dense LU.
 
 use super::common::scene;
-use crate::integrator::{
-    initial_state, iteration_scaling, GaState, IterationMatrix, LinearSolver, Settings, Stats,
-    Stepper,
-};
+use super::sparse_iteration_matrix::{built, dense_matrix};
+use crate::integrator::{iteration_scaling, IterationMatrix, LinearSolver, Stats, Stepper};
 use crate::mechanics::multibody::Equations;
 use crate::mechanics::Mechanics;
-use crate::unit::effects::resolve;
 use crate::Scene;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// C2's pendulum as one frame of `elements` at a fixed step of 1e-3 s.
 fn one_frame(elements: usize) -> Scene {
@@ -23,13 +20,6 @@ fn one_frame(elements: usize) -> Scene {
     s.solver.max_step = 1e-3;
     s.solver.tolerance = 1e-8;
     Scene::from_toml_str(&s.to_toml_string(), "flexible_pendulum.toml").expect("valid")
-}
-
-fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
-    let sys = Mechanics::build(s, &resolve(s).effects);
-    let settings = Settings::from_scene(s);
-    let st = initial_state(&sys, 0.0, &settings).expect("assembles");
-    (sys, st, settings)
 }
 
 /// The tip's height (m) at coordinates q.
@@ -67,21 +57,8 @@ fn auto_takes_the_bordered_band_for_a_long_frame_only() {
 fn the_bordered_band_solves_what_the_dense_matrices_give() {
     let (sys, st, settings) = built(&one_frame(32));
     let (n, m) = (sys.n(), sys.m());
-    let (mut mm, mut kt, mut ct) = (
-        DMatrix::zeros(n, n),
-        DMatrix::zeros(n, n),
-        DMatrix::zeros(n, n),
-    );
-    let mut g = DMatrix::zeros(m, n);
-    sys.mass_matrix(&st.q, &mut mm);
-    sys.tangents(&st.point(), &mut kt, &mut ct);
-    sys.constraint_jacobian(&st.q, st.t, &mut g);
+    let a = dense_matrix(&sys, &st, settings.max_step, settings.rho_inf);
     let w = iteration_scaling(settings.rho_inf, settings.max_step);
-    let mut a = DMatrix::zeros(n + m, n + m);
-    a.view_mut((0, 0), (n, n))
-        .copy_from(&(kt * w.d + mm * w.cm + ct * w.cc));
-    a.view_mut((0, n), (n, m)).copy_from(&g.transpose());
-    a.view_mut((n, 0), (m, n)).copy_from(&g);
     let b = DVector::from_fn(n + m, |i, _| (i as f64 * 0.7).sin() + 0.1);
     let expected = a.clone().lu().solve(&b).expect("regular");
     let mut matrix = IterationMatrix::new(&sys, LinearSolver::Auto);

@@ -28,7 +28,8 @@ fn substructured(file: &str, k: usize, step: f64) -> Scene {
     Scene::from_toml_str(&s.to_toml_string(), file).expect("valid")
 }
 
-fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
+/// The system of `s`, its consistent initial state and its integrator settings.
+pub(super) fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
     let sys = Mechanics::build(s, &resolve(s).effects);
     let settings = Settings::from_scene(s);
     let st = initial_state(&sys, 0.0, &settings).expect("assembles");
@@ -36,7 +37,7 @@ fn built(s: &Scene) -> (Mechanics, GaState, Settings) {
 }
 
 /// [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]] from the dense methods of `Equations`.
-fn dense_matrix(sys: &Mechanics, st: &GaState, h: f64, rho_inf: f64) -> DMatrix<f64> {
+pub(super) fn dense_matrix(sys: &Mechanics, st: &GaState, h: f64, rho_inf: f64) -> DMatrix<f64> {
     let (n, m) = (sys.n(), sys.m());
     let (mut mm, mut kt, mut ct) = (
         DMatrix::zeros(n, n),

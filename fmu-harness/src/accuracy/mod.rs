@@ -27,6 +27,7 @@ mod pool;
 mod recentre;
 pub mod report;
 mod run;
+pub use run::thread_cpu_seconds;
 mod runner;
 pub mod truth;
 

@@ -50,8 +50,9 @@ pub(super) struct Outcome {
     pub(super) seconds: f64,
 }
 
-/// CPU seconds this thread has run (the scheduler's account), where Linux says.
-pub(super) fn thread_cpu_seconds() -> Option<f64> {
+/// CPU seconds this thread has run (the scheduler's account), where Linux says (None
+/// elsewhere): the accuracy study's and the benchmarks' clock.
+pub fn thread_cpu_seconds() -> Option<f64> {
     std::fs::read_to_string("/proc/thread-self/schedstat")
         .ok()?
         .split_whitespace()

@@ -108,11 +108,20 @@ impl ArrowBand {
     }
 
     /// y = α A x + β y over slices of length n.
+    /// Without a work vector (it runs in every Newton iteration): `for_each_entry` visits the
+    /// rows in order, so each row's sum is done before the next row begins.
     pub fn gemv(&self, alpha: f64, x: &[f64], beta: f64, y: &mut [f64]) {
-        let mut ax = vec![0.0; self.n];
-        self.for_each_entry(|i, j, a| ax[i] += a * x[j]);
-        for (yi, a) in y.iter_mut().zip(&ax) {
-            *yi = alpha * a + beta * *yi;
+        let (mut row, mut sum) = (0, 0.0);
+        self.for_each_entry(|i, j, a| {
+            while row < i {
+                y[row] = alpha * sum + beta * y[row];
+                (row, sum) = (row + 1, 0.0);
+            }
+            sum += a * x[j];
+        });
+        while row < self.n {
+            y[row] = alpha * sum + beta * y[row];
+            (row, sum) = (row + 1, 0.0);
         }
     }
 
