@@ -91,7 +91,7 @@ pub enum EngineError {
     },
     #[error(
         "doStep: the work budget of one communication step is spent: {work} work units (Newton \
-         iterations times unknowns, factorizations times unknowns squared; solver.step_budget = \
+         iterations times unknowns, factorizations times the matrix's stored entries; solver.step_budget = \
          {budget}, a few seconds of work, documented in docs/robustness.md) in {attempts} \
          internal steps between t = {} s and t = {} s, without reaching t = {} s; the last good \
          state is kept (a shorter communication step, or a scene whose forces and solver \

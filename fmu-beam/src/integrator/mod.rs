@@ -41,13 +41,14 @@ pub struct Settings {
     pub step_budget: u64,
 }
 
-/// The default work budget of a communication step, in [`work_units`]: 3e7 units are 2–4 s on
-/// the shipped scenes (60–200 ns a unit, measured over their default experiments on one core
-/// of the development machine: `fmu-beam/tests/issue_45_work_budget.rs`). A communication step
-/// that needs more (a doStep of 1e6 s took 287 s on rollup_3d and 66 s on spin_up_omega10
-/// when the budget counted 1e6 internal steps, whatever each cost) ends in a Discard within
-/// seconds instead; `solver.step_budget` sets it. No doStep of a shipped scene's
-/// DefaultExperiment comes near it (the largest takes 6e4 units).
+/// The default work budget of a communication step, in [`work_units`]: 3e7 units are 1–4.5 s
+/// on the shipped scenes (30–150 ns a unit; doStep(0, 1e6) of each on one core of the
+/// development machine beside another build, 2026-12-06: `worst_do_step_of_every_shipped_scene`
+/// in `fmu-beam/tests/issue_45_work_budget.rs`). A communication step that needs more (a doStep
+/// of 1e6 s took 287 s on rollup_3d and 66 s on spin_up_omega10 when the budget counted 1e6
+/// internal steps, whatever each cost) ends in a Discard within seconds instead;
+/// `solver.step_budget` sets it. No doStep of a shipped scene's DefaultExperiment comes near it
+/// (the largest, rollup_3d's, takes 4.9e5 units).
 pub const DEFAULT_STEP_BUDGET: u64 = crate::scene::DEFAULT_STEP_BUDGET;
 
 /// Work units per Newton iteration beyond one per unknown: the iteration's fixed cost (the
@@ -56,16 +57,24 @@ pub const DEFAULT_STEP_BUDGET: u64 = crate::scene::DEFAULT_STEP_BUDGET;
 const ITERATION_OVERHEAD: u64 = 32;
 
 /// The work of `iterations` Newton iterations and `factorizations` iteration matrices (each
-/// evaluated and factorized) for a system of `unknowns` (n + m): iterations × (unknowns +
-/// [`ITERATION_OVERHEAD`]) + factorizations × unknowns² / 4. The time of a run follows it to a
-/// factor of 2 over every shipped scene (a residual and a solve cost about one unit per
-/// unknown; evaluating the tangents and factorizing, dense below 60 unknowns and sparse above,
-/// a quarter unit per unknown squared: 30–55 ns per unknown² measured, the roll-up's 3D
-/// tangents by central differences included).
-pub fn work_units(iterations: u64, factorizations: u64, unknowns: u64) -> u64 {
+/// evaluated and factorized) for a system of `unknowns` (n + m) whose iteration matrix costs
+/// `per_factorization` units ([`IterationMatrix::factorization_units`]: unknowns² / 4 when
+/// dense): iterations × (unknowns + [`ITERATION_OVERHEAD`]) + factorizations ×
+/// per_factorization. A residual and a solve cost about one unit per unknown; evaluating the
+/// tangents and factorizing a dense matrix a quarter unit per unknown² (30–55 ns per unknown²
+/// measured, the roll-up's 3D tangents included). Counted as dense whatever the matrix, a
+/// factorization of the 64-substructure roll-up (1 280 unknowns, 32 292 entries stored) read
+/// 13 times its sparse count: one doStep of 0.01 s of its DefaultExperiment counted 5.0e6, a
+/// sixth of the default budget.
+pub fn work_units(
+    iterations: u64,
+    factorizations: u64,
+    unknowns: u64,
+    per_factorization: u64,
+) -> u64 {
     iterations
         .saturating_mul(unknowns + ITERATION_OVERHEAD)
-        .saturating_add(factorizations.saturating_mul(unknowns * unknowns / 4))
+        .saturating_add(factorizations.saturating_mul(per_factorization))
 }
 
 impl Settings {

@@ -171,10 +171,10 @@ pub struct SolverSpec {
     #[serde(default = "default_rho_inf")]
     pub rho_inf: f64,
     /// The work budget of one communication step, in work units (Newton iterations times
-    /// unknowns plus 32, plus iteration matrices times unknowns² / 4) before the step ends in
-    /// fmi2Discard with the reason, the last good state kept. The default, 30 000 000, is 2–4 s of work on any
-    /// shipped scene; a master that takes long communication steps of a fine fixed step
-    /// raises it.
+    /// unknowns plus 32, plus iteration matrices times the entries the matrix stores / 4:
+    /// unknowns² when dense) before the step ends in fmi2Discard with the reason, the last good
+    /// state kept. The default, 30 000 000, is seconds of work on any shipped scene; a master
+    /// that takes long communication steps of a fine fixed step raises it.
     #[serde(default = "default_step_budget")]
     pub step_budget: u64,
 }

@@ -477,12 +477,14 @@ impl Stepper {
         let (t_start, mut attempts) = (st.t, 0u64);
         // the work of this call, counted as it is done ([`super::work_units`])
         let unknowns = (sys.n() + sys.m()) as u64;
+        let per_factorization = self.matrix.factorization_units();
         let (iterations, factorizations) = (stats.newton_iterations, stats.jacobians);
         let work = |stats: &Stats| {
             super::work_units(
                 stats.newton_iterations - iterations,
                 stats.jacobians - factorizations,
                 unknowns,
+                per_factorization,
             )
         };
         while !reached(st.t) {
