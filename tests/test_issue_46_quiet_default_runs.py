@@ -24,16 +24,10 @@ ENDS_BY_DESIGN = {
     "spin_up_omega10_single_frame",
 }
 
-# Shipped scenes that still warn, for a real reason, with the warning's words. The C5 roll-ups
-# close a circle with 10 frames tangent at their roots: each ends bent by pi/10, 31 % of its
-# length (the monitor warns at 5 %, on the way). The closure at the end is exact by symmetry,
-# but half-way (t = 1 s) rollup_3d_z's tip is 1.0e-2 m (1 % of L) off the 64-substructure run.
-# Quiet needs about 64 substructures (pi/64 < 5 %): their fix is left open (issue 46). When a
-# scene here runs quiet, this test fails: remove it from the list.
-STILL_WARNS = {
-    "rollup_3d": "beyond the small-deformation range",
-    "rollup_3d_z": "beyond the small-deformation range",
-}
+# Shipped scenes that still warn, for a real reason, with the warning's words (none now: the C5
+# roll-ups warned with the paper's 10 frames, each bent by pi/10 of its length at the end; they
+# ship 64). When a scene here runs quiet, this test fails: remove it from the list.
+STILL_WARNS: dict[str, str] = {}
 
 
 def run_logged(path, logging_on):
