@@ -71,7 +71,7 @@ win64-tools:
 	  || echo "win64-tools: could not install them" >&2; \
 	fi
 
-# The workspace but the Python extension, which `wheel` builds (maturin) from the same rlibs.
+# The workspace but the Python extension, which `wheel` builds (maturin, for an explicit target).
 release:
 	cargo build --release --workspace --exclude fmu-beam-py
 
@@ -115,15 +115,19 @@ fmus: release win64
 # glibc 2.28's (`auditwheel show dist/*.whl` says which tag the wheel deserves). The linux64 engine
 # must be linked so too; maturin's cargo build makes it on the way (fmu-beam is a cdylib too), so a
 # first pass builds everything, the engine is copied in, and a second pass (nothing left to
-# compile) packs the wheel. The win64 engine is `make win64`'s. The wheel is then installed into
-# .venv (its dependencies are requirements.txt's), where the tests of the Python API import it.
+# compile) packs the wheel. The win64 engine is `make win64`'s, made (or waited for: `make test`
+# builds it in the background) after the first pass, which compiles every dependency again for
+# the explicit target and so fills the cores while the Windows build ends. The wheel is then
+# installed into .venv (its dependencies are requirements.txt's), where the tests of the Python
+# API import it.
 WHEEL_ENGINES := python/fmu_beam/engines
 WHEEL_TARGET  := x86_64-unknown-linux-gnu
 MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" nice $(VENV)/bin/maturin build --release \
   --zig --compatibility manylinux_2_28
-wheel: .venv win64
+wheel: .venv
 	rm -rf $(WHEEL_ENGINES) build/wheel/first dist/fmu_beam-*.whl
 	$(MATURIN) --out build/wheel/first
+	$(MAKE) --no-print-directory win64
 	mkdir -p $(WHEEL_ENGINES)/linux64
 	cp target/$(WHEEL_TARGET)/release/deps/libfmu_beam.so $(WHEEL_ENGINES)/linux64/
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
@@ -180,11 +184,14 @@ demo: .venv fmus
 	$(PY) tests/demo_animations.py
 
 # The Windows engine builds in the background (log: build/win64/build.log) while the Linux
-# build and the Rust tests run; `fmus` then waits for it (cargo's lock on $(WIN64_DIR)).
+# build and the Rust tests run; the wheel's first pass fills the cores while it ends, then waits
+# for it (cargo's lock on $(WIN64_DIR)), and `fmus` finds it built.
 # pytest runs in two processes side by side: tests/test_no_leaks.py (1e4 cycles under
 # valgrind, 3.5 min on one core; its own --basetemp, its output after the rest's) and the rest
 # (3 min): 3.4 min in all, where one after the other took 7.2 in the last CI (2026-11-29).
-# The fuzz stage runs last, shorter than `make fuzz` alone (issue 45 item 9: a couple of minutes).
+# The fuzz stage runs last, shorter than `make fuzz` alone (issue 45 item 9: a couple of
+# minutes), its two halves side by side (each is one process, bounded in time; outputs in
+# build/fuzz.log and build/fuzz-python.log, shown after both).
 TEST_FUZZ_SECONDS        ?= 60
 TEST_FUZZ_PYTHON_SECONDS ?= 30
 test: .venv tools browser win64-tools
@@ -195,8 +202,8 @@ test: .venv tools browser win64-tools
 	fi
 	$(MAKE) --no-print-directory release
 	cargo test --workspace --exclude fmu-beam-py --release --no-fail-fast
-	$(MAKE) --no-print-directory fmus
 	$(MAKE) --no-print-directory wheel
+	$(MAKE) --no-print-directory fmus
 	@mkdir -p build; \
 	$(PY) -m pytest tests/test_no_leaks.py -q -p no:cacheprovider --basetemp=build/pytest-leaks \
 	  >build/pytest-leaks.log 2>&1 & leaks=$$!; \
@@ -204,8 +211,11 @@ test: .venv tools browser win64-tools
 	rest=0; WIN64=$(WIN64) $(PY) -m pytest tests -q --ignore=tests/test_no_leaks.py || rest=$$?; \
 	leaked=0; wait $$leaks || leaked=$$?; \
 	echo "pytest tests/test_no_leaks.py:"; cat build/pytest-leaks.log; \
-	fuzzed=0; $(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS) || fuzzed=$$?; \
-	pyfuzzed=0; $(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS) || pyfuzzed=$$?; \
+	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS) >build/fuzz.log 2>&1 & fuzz=$$!; \
+	$(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS) \
+	  >build/fuzz-python.log 2>&1 & pyfuzz=$$!; \
+	fuzzed=0; wait $$fuzz || fuzzed=$$?; pyfuzzed=0; wait $$pyfuzz || pyfuzzed=$$?; \
+	echo "make fuzz:"; cat build/fuzz.log; echo "make fuzz-python:"; cat build/fuzz-python.log; \
 	exit $$(( rest || leaked || fuzzed || pyfuzzed ))
 
 check:
