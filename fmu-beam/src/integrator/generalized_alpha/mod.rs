@@ -16,7 +16,7 @@
 
 use super::initial::{self, Equated};
 use super::iteration_matrix::{IterationMatrix, LinearSolver, Scaling};
-use super::newton::{Contraction, Verdict, KAPPA, STALE, STALE_TURNED};
+use super::newton::{Contraction, Verdict, AFTER_REFRESH, KAPPA, STALE, STALE_TURNED};
 use super::{Settings, Stats};
 use crate::error::EngineError;
 use crate::mechanics::multibody::{CoordinateKind, Equations, JacobianRows, Point, Turning};

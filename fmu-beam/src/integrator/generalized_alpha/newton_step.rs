@@ -50,6 +50,20 @@ impl Stepper {
     }
 
     /// One step of size h from `st`; returns the new state and the local error norm.
+    /// Whether evaluating the iteration matrix again at the current iterate costs less than
+    /// the corrections the current one still needs at its measured rate: a factorization
+    /// counts its work units ([`IterationMatrix::factorization_units`]) in iterations
+    /// ([`super::super::ITERATION_OVERHEAD`] plus one per unknown), and the new matrix
+    /// [`AFTER_REFRESH`] corrections.
+    fn refresh_pays(&self, norm: f64, kappa: f64, unknowns: usize) -> bool {
+        let iteration = (unknowns as u64 + super::super::ITERATION_OVERHEAD) as f64;
+        let factorization = self.matrix.factorization_units() as f64 / iteration;
+        self.memory
+            .contraction
+            .remaining(norm, kappa)
+            .is_some_and(|left| left > AFTER_REFRESH + factorization)
+    }
+
     pub(super) fn attempt<S: Equations + ?Sized>(
         &mut self,
         sys: &S,
@@ -227,8 +241,13 @@ impl Stepper {
                     prev = norm;
                     // a matrix that contracts slowly (it was evaluated at a predictor far from
                     // the solution, or steps ago) is evaluated again at the current iterate,
-                    // close to the solution: Newton's own quadratic convergence
-                    if self.memory.contraction.stalls() && k > 2 && refreshed < MAX_REFRESH {
+                    // close to the solution: Newton's own quadratic convergence; so is one
+                    // whose remaining corrections cost more than a new one
+                    let pays = || self.refresh_pays(norm, kappa, n + m);
+                    if k > 2
+                        && refreshed < MAX_REFRESH
+                        && (self.memory.contraction.stalls() || pays())
+                    {
                         self.matrix.forget();
                         refreshed += 1;
                     }
