@@ -4,6 +4,8 @@
 //! of them works on. [`Shape::work`] weighs the counts by the work each does, in seconds of
 //! the machine where the weights were fitted (docs/accuracy.md, "What a run costs").
 
+use fmu_beam::integrator::{IterationMatrix, LinearSolver};
+use fmu_beam::mechanics::{Equations, Mechanics};
 use fmu_beam::Scene;
 
 /// What the engine counted over a run, and the grid it recorded.
@@ -26,7 +28,9 @@ pub struct Shape {
     pub unknowns: f64,
     /// The sum over floating frames (and rigid bodies) of their coordinates squared: each
     /// frame's mass, stiffness and inertia blocks are dense over its own coordinates, and an
-    /// iteration matrix is assembled and factorized block by block.
+    /// iteration matrix is assembled and factorized block by block. Where the engine
+    /// factorizes by the bordered banded LU (one frame of 16 elements or more), a banded
+    /// block counts the entries it stores instead ([`banded_blocks`]).
     pub blocks: f64,
     /// Coordinates of the largest frame (or body).
     pub largest: f64,
@@ -71,7 +75,7 @@ impl Shape {
         }
         Shape {
             unknowns: s.size().unknowns() as f64,
-            blocks,
+            blocks: banded_blocks(scene).unwrap_or(blocks),
             largest,
         }
     }
@@ -87,9 +91,60 @@ impl Shape {
     }
 }
 
+/// The entries the scene's blocks store, where the engine factorizes its iteration matrix by
+/// the bordered banded LU (`fmu_beam::integrator::prefers_bordered`); None where it does not.
+/// A banded frame's blocks are assembled and factorized in time linear in its coordinates
+/// (docs/accuracy.md, "How the cost grows with the model"). Counted as its coordinates
+/// squared, one frame of 64 elements read 5.3 times its CPU time per step (0.90 ms against
+/// 0.17 ms measured by `make bench-scaling`, 2026-12-06, with its counts: 3.7 Newton
+/// iterations and 0.52 iteration matrices a step), 128 elements 10.7 times (3.4 ms against
+/// 0.32 ms); counted by its stored entries, 0.76 and 0.81 times.
+fn banded_blocks(scene: &Scene) -> Option<f64> {
+    let sys = Mechanics::build(scene, &fmu_beam::resolve_effects(scene).effects);
+    if !IterationMatrix::new(&sys, LinearSolver::Auto).is_bordered() {
+        return None;
+    }
+    Some(
+        sys.block_diagonal()
+            .blocks
+            .iter()
+            .map(|b| b.stored() as f64)
+            .sum(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// C2's pendulum as one frame of `elements` (the shipped scene's text, its count changed).
+    fn one_frame(elements: usize) -> Scene {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenes/flexible_pendulum.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        assert!(text.contains("elements = 10\n"));
+        let text = text.replace("elements = 10\n", &format!("elements = {elements}\n"));
+        Scene::from_toml_str(&text, "flexible_pendulum.toml").unwrap()
+    }
+
+    /// A frame the engine factorizes dense weighs its coordinates squared; one it factorizes
+    /// by the bordered banded LU, the entries its blocks store (linear in its elements).
+    #[test]
+    fn a_banded_frame_weighs_what_it_stores() {
+        let dense = Shape::of(&one_frame(10));
+        // the frame's 3 + 3 × 10 coordinates
+        assert!(banded_blocks(&one_frame(10)).is_none());
+        assert_eq!(dense.blocks, 33.0 * 33.0, "{dense:?}");
+        let (b64, b128) = (Shape::of(&one_frame(64)), Shape::of(&one_frame(128)));
+        let squared = |s: &Shape| s.largest * s.largest;
+        println!("64: {b64:?}, 128: {b128:?}");
+        assert!(b64.blocks < 0.1 * squared(&b64), "{b64:?}");
+        // linear: twice the elements, about twice the entries
+        let growth = b128.blocks / b64.blocks;
+        assert!((1.9..2.1).contains(&growth), "{growth}");
+    }
 
     /// The weights as documented: given counts on a given shape weigh one number, bit for bit.
     #[test]

@@ -55,6 +55,11 @@ impl ArrowBand {
         self.width
     }
 
+    /// Entries stored: the head's rows and columns and the tail's band.
+    pub fn stored(&self) -> usize {
+        self.rows.len() + self.cols.len() + self.band.len()
+    }
+
     pub fn fill_zero(&mut self) {
         self.rows.fill(0.0);
         self.cols.fill(0.0);

@@ -25,6 +25,14 @@ impl Block {
         }
     }
 
+    /// Entries stored: n² dense, the arrow and band of a banded block.
+    pub fn stored(&self) -> usize {
+        match self {
+            Block::Dense(d) => d.len(),
+            Block::Band(b) => b.stored(),
+        }
+    }
+
     pub fn fill_zero(&mut self) {
         match self {
             Block::Dense(d) => d.fill(0.0),
