@@ -91,20 +91,8 @@ impl Instance {
 
     /// Maps an engine error to a fault and moves the call-sequence state as the failure says.
     fn fail(&mut self, e: EngineError) -> Fault {
-        use EngineError as E;
-        let refused = matches!(
-            e,
-            E::UnknownValueReference { .. }
-                | E::NotSettable { .. }
-                | E::NonFiniteValue { .. }
-                | E::InvalidValue { .. }
-                | E::BadStep { .. }
-                | E::BadState { .. }
-                | E::Experiment { .. }
-                | E::DirectionalDerivative { .. }
-                | E::FeedthroughSingular { .. }
-        );
-        if let E::BadStep { message } = e {
+        let refused = e.is_refusal();
+        if let EngineError::BadStep { message } = e {
             // The engine's text starts with "doStep: "; the guard names the function already.
             return Fault::refused(message);
         }
