@@ -177,6 +177,7 @@ pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
 /// # Safety
 /// As for the fmi3Get functions.
 unsafe fn get<T>(
+    name: &'static str,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     nvr: usize,
@@ -186,7 +187,7 @@ unsafe fn get<T>(
     convert: impl Fn(f64) -> T,
 ) -> fmi3Status {
     unsafe {
-        guard(instance, Call::Get, |s| {
+        guard(instance, Call::Get(name), |s| {
             let vr = slice(vr, nvr, "valueReferences")?;
             let out = slice_mut(values, n, "values")?;
             let got = s.get(vr, ty, n)?;
@@ -203,6 +204,7 @@ unsafe fn get<T>(
 /// # Safety
 /// As for the fmi3Set functions.
 unsafe fn set<T: Copy>(
+    name: &'static str,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     nvr: usize,
@@ -212,7 +214,7 @@ unsafe fn set<T: Copy>(
     convert: impl Fn(T) -> f64,
 ) -> fmi3Status {
     unsafe {
-        guard(instance, Call::Set, |s| {
+        guard(instance, Call::Set(name), |s| {
             let vr = slice(vr, nvr, "valueReferences")?;
             let values: Vec<f64> = slice(values, n, "values")?
                 .iter()
@@ -234,7 +236,18 @@ pub unsafe extern "C" fn fmi3GetFloat64(
     nValues: usize,
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
-    unsafe { get(instance, vr, nvr, values, nValues, VarType::Real, |v| v) }
+    unsafe {
+        get(
+            "fmi3GetFloat64",
+            instance,
+            vr,
+            nvr,
+            values,
+            nValues,
+            VarType::Real,
+            |v| v,
+        )
+    }
 }
 
 /// # Safety
@@ -248,7 +261,18 @@ pub unsafe extern "C" fn fmi3SetFloat64(
     nValues: usize,
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
-    unsafe { set(instance, vr, nvr, values, nValues, VarType::Real, |v| v) }
+    unsafe {
+        set(
+            "fmi3SetFloat64",
+            instance,
+            vr,
+            nvr,
+            values,
+            nValues,
+            VarType::Real,
+            |v| v,
+        )
+    }
 }
 
 /// # Safety
@@ -264,9 +288,16 @@ pub unsafe extern "C" fn fmi3GetInt32(
     let (vr, nvr) = (valueReferences, nValueReferences);
     // the engine's integers are i32, carried exactly by f64
     unsafe {
-        get(instance, vr, nvr, values, nValues, VarType::Integer, |v| {
-            v as i32
-        })
+        get(
+            "fmi3GetInt32",
+            instance,
+            vr,
+            nvr,
+            values,
+            nValues,
+            VarType::Integer,
+            |v| v as i32,
+        )
     }
 }
 
@@ -283,6 +314,7 @@ pub unsafe extern "C" fn fmi3SetInt32(
     let (vr, nvr) = (valueReferences, nValueReferences);
     unsafe {
         set(
+            "fmi3SetInt32",
             instance,
             vr,
             nvr,
@@ -308,6 +340,7 @@ pub unsafe extern "C" fn fmi3GetBoolean(
     let to_bool = |v: f64| if v != 0.0 { fmi3True } else { fmi3False };
     unsafe {
         get(
+            "fmi3GetBoolean",
             instance,
             vr,
             nvr,
@@ -333,6 +366,7 @@ pub unsafe extern "C" fn fmi3SetBoolean(
     let from_bool = |b: fmi3Boolean| if b != fmi3False { 1.0 } else { 0.0 };
     unsafe {
         set(
+            "fmi3SetBoolean",
             instance,
             vr,
             nvr,
@@ -358,7 +392,11 @@ macro_rules! no_variables_of {
             _values: $values,
             _nValues: usize,
         ) -> fmi3Status {
-            let call = if stringify!($name).starts_with("fmi3Get") { Call::Get } else { Call::Set };
+            let call = if stringify!($name).starts_with("fmi3Get") {
+                Call::Get(stringify!($name))
+            } else {
+                Call::Set(stringify!($name))
+            };
             unsafe {
                 guard(instance, call, |s| {
                     s.no_variables_of($type_name, slice(valueReferences, nValueReferences, "valueReferences")?)
@@ -402,7 +440,7 @@ pub unsafe extern "C" fn fmi3GetBinary(
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
     unsafe {
-        guard(instance, Call::Get, |s| {
+        guard(instance, Call::Get("fmi3GetBinary"), |s| {
             s.no_variables_of("Binary", slice(vr, nvr, "valueReferences")?)
         })
     }
@@ -421,7 +459,7 @@ pub unsafe extern "C" fn fmi3SetBinary(
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
     unsafe {
-        guard(instance, Call::Set, |s| {
+        guard(instance, Call::Set("fmi3SetBinary"), |s| {
             s.no_variables_of("Binary", slice(vr, nvr, "valueReferences")?)
         })
     }
@@ -438,7 +476,7 @@ pub unsafe extern "C" fn fmi3GetClock(
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
     unsafe {
-        guard(instance, Call::Get, |s| {
+        guard(instance, Call::Get("fmi3GetClock"), |s| {
             s.no_variables_of("Clock", slice(vr, nvr, "valueReferences")?)
         })
     }
@@ -455,7 +493,7 @@ pub unsafe extern "C" fn fmi3SetClock(
 ) -> fmi3Status {
     let (vr, nvr) = (valueReferences, nValueReferences);
     unsafe {
-        guard(instance, Call::Set, |s| {
+        guard(instance, Call::Set("fmi3SetClock"), |s| {
             s.no_variables_of("Clock", slice(vr, nvr, "valueReferences")?)
         })
     }

@@ -35,8 +35,10 @@ pub enum Call {
     ExitInitializationMode,
     Terminate,
     Reset,
-    Get,
-    Set,
+    /// A getter, by its C name (fmi3GetFloat64 ...).
+    Get(&'static str),
+    /// A setter, by its C name.
+    Set(&'static str),
     GetFMUState,
     SetFMUState,
     FreeFMUState,
@@ -59,7 +61,7 @@ const ERROR: u8 = S::Error.bit();
 const ANY: u8 = INSTANTIATED | INIT | STEPPING | TERMINATED | ERROR;
 
 impl Call {
-    /// The C name (a getter or setter by its family), for messages.
+    /// The C name, for messages.
     pub fn name(self) -> &'static str {
         use Call as C;
         match self {
@@ -68,8 +70,7 @@ impl Call {
             C::ExitInitializationMode => "fmi3ExitInitializationMode",
             C::Terminate => "fmi3Terminate",
             C::Reset => "fmi3Reset",
-            C::Get => "fmi3Get<Type>",
-            C::Set => "fmi3Set<Type>",
+            C::Get(name) | C::Set(name) => name,
             C::GetFMUState => "fmi3GetFMUState",
             C::SetFMUState => "fmi3SetFMUState",
             C::FreeFMUState => "fmi3FreeFMUState",
@@ -94,8 +95,8 @@ impl Call {
             C::EnterInitializationMode => INSTANTIATED,
             C::ExitInitializationMode => INIT,
             C::Terminate => STEPPING,
-            C::Get | C::GetDirectionalDerivative => INIT | STEPPING | TERMINATED | ERROR,
-            C::Set => INSTANTIATED | INIT | S::StepMode.bit(),
+            C::Get(_) | C::GetDirectionalDerivative => INIT | STEPPING | TERMINATED | ERROR,
+            C::Set(_) => INSTANTIATED | INIT | S::StepMode.bit(),
             C::GetFMUState => INSTANTIATED | INIT | STEPPING | TERMINATED,
             C::SetFMUState
             | C::FreeFMUState
@@ -138,7 +139,7 @@ mod tests {
     #[test]
     fn setters_not_after_a_failure_or_the_end() {
         for s in [S::StepDiscarded, S::Terminated, S::Error] {
-            assert!(check(s, Call::Set).is_err(), "{s:?}");
+            assert!(check(s, Call::Set("fmi3SetFloat64")).is_err(), "{s:?}");
         }
     }
 }

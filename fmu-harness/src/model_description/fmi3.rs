@@ -55,11 +55,22 @@ fn log_categories() -> Result<String, HarnessError> {
     let mut x = Xml::new();
     x.start("LogCategories", &[])?;
     for (name, description) in LOG_CATEGORIES {
-        let description = description.replace("fmi2", "fmi3");
+        let description = statuses3(description);
         x.empty("Category", &[("name", name), ("description", &description)])?;
     }
     x.end("LogCategories")?;
     x.finish()
+}
+
+/// A text with FMI 2.0's status names (fmi2OK ... fmi2Fatal) as FMI 3.0's; other names of
+/// functions stay (a derivative input's text names fmi2SetRealInputDerivatives, which FMI 3.0
+/// does not have: there, the derivative is its own input).
+fn statuses3(text: &str) -> String {
+    ["OK", "Warning", "Discard", "Error", "Fatal"]
+        .iter()
+        .fold(text.to_string(), |t, s| {
+            t.replace(&format!("fmi2{s}"), &format!("fmi3{s}"))
+        })
 }
 
 /// The element name of a variable type in FMI 3.0.
@@ -103,8 +114,8 @@ fn model_variables(table: &VariableTable, layout: &Layout3) -> Result<String, Ha
         let description = match v3.declared {
             Declared::Array { .. } => array_description(&v.description, n),
             _ => v.description.clone(),
-        }
-        .replace("fmi2", "fmi3");
+        };
+        let description = statuses3(&description);
         let mut attrs = vec![
             ("name", v3.name.as_str()),
             ("valueReference", vr.as_str()),
