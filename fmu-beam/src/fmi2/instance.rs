@@ -29,6 +29,7 @@ use super::types::{
 };
 use crate::error::EngineError;
 use crate::unit::engine::Engine;
+use crate::unit::retry::Retry;
 use crate::unit::variables::VarType;
 
 pub struct Instance {
@@ -37,8 +38,8 @@ pub struct Instance {
     engine: Engine,
     /// Why the unit cannot continue (fmi2Terminated = true), set with `StepFailed`.
     ended: Option<String>,
-    /// The (t, h) of the last step that failed with a Discard a retry may overcome.
-    last_discard: Option<(f64, f64)>,
+    /// Whether a failed step may be retried.
+    retry: Retry,
     /// The tolerance the master passed to fmi2SetupExperiment (toleranceDefined), if any.
     master_tolerance: Option<f64>,
 }
@@ -84,7 +85,7 @@ impl Instance {
             state: ModelState::Instantiated,
             engine: Engine::new(scene),
             ended: None,
-            last_discard: None,
+            retry: Retry::default(),
             master_tolerance: None,
         })
     }
@@ -227,7 +228,7 @@ impl Instance {
     pub fn reset(&mut self) -> Result<(), Fault> {
         self.engine.reset();
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.master_tolerance = None;
         self.transition(ModelState::Instantiated);
         Ok(())
@@ -304,7 +305,7 @@ impl Instance {
         }
         match result {
             Ok(()) => {
-                self.last_discard = None;
+                self.retry.clear();
                 Ok(())
             }
             Err(e) if e.is_discard() && self.state == ModelState::StepComplete => {
@@ -319,16 +320,7 @@ impl Instance {
     /// the step that failed; then the unit ends the simulation (fmi2Terminated = true).
     fn discard(&mut self, e: EngineError, t: f64, h: f64) -> Fault {
         let good = self.engine.time();
-        let why = if e.ends_run() {
-            Some("a smaller step cannot get past this")
-        } else if self.last_discard == Some((t, h)) {
-            Some(
-                "the master repeated the step that failed, with the same size; the unit is \
-                 deterministic, so it fails the same way (a retry needs a smaller step)",
-            )
-        } else {
-            None
-        };
+        let why = self.retry.judge(&e, t, h);
         let message = match why {
             Some(why) => {
                 self.ended = Some(format!("{e}; {why}"));
@@ -339,7 +331,6 @@ impl Instance {
                 )
             }
             None => {
-                self.last_discard = Some((t, h));
                 format!(
                     "{e}; the state is back at the last good time t = {good} s \
                      (fmi2LastSuccessfulTime): retry fmi2DoStep from there with a smaller step"
@@ -370,7 +361,7 @@ impl Instance {
         }
         self.transition(s.model_state());
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.logger
             .event(&format!("FMU state restored at t = {}", self.engine.time()));
         Ok(())

@@ -22,6 +22,7 @@ use super::state_machine::State;
 use super::types::fmi3Status;
 use crate::error::EngineError;
 use crate::unit::engine::Engine;
+use crate::unit::retry::Retry;
 use crate::unit::variables::{Declared, Layout3, VarType};
 
 pub struct Instance {
@@ -31,8 +32,8 @@ pub struct Instance {
     layout: Layout3,
     /// Why the unit cannot continue (terminateSimulation = true), set with `StepDiscarded`.
     ended: Option<String>,
-    /// The (t, h) of the last step that failed with a Discard a retry may overcome.
-    last_discard: Option<(f64, f64)>,
+    /// Whether a failed step may be retried.
+    retry: Retry,
 }
 
 /// What fmi3DoStep reports besides its status.
@@ -88,7 +89,7 @@ impl Instance {
             engine,
             layout,
             ended: None,
-            last_discard: None,
+            retry: Retry::default(),
         })
     }
 
@@ -186,7 +187,7 @@ impl Instance {
     pub fn reset(&mut self) -> Result<(), Fault> {
         self.engine.reset();
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.transition(State::Instantiated);
         Ok(())
     }
@@ -282,7 +283,7 @@ impl Instance {
         self.pass_messages();
         match result {
             Ok(()) => {
-                self.last_discard = None;
+                self.retry.clear();
                 Ok(StepReport {
                     terminate: false,
                     last_successful_time: self.engine.time(),
@@ -296,16 +297,7 @@ impl Instance {
     /// A step that failed with a Discard: the state is back at `t`.
     fn discard(&mut self, e: EngineError, t: f64, h: f64) -> Fault {
         let good = self.engine.time();
-        let why = if e.ends_run() {
-            Some("a smaller step cannot get past this")
-        } else if self.last_discard == Some((t, h)) {
-            Some(
-                "the importer repeated the step that failed, with the same size; the unit is \
-                 deterministic, so it fails the same way (a retry needs a smaller step)",
-            )
-        } else {
-            None
-        };
+        let why = self.retry.judge(&e, t, h);
         let message = match why {
             Some(why) => {
                 self.ended = Some(format!("{e}; {why}"));
@@ -316,7 +308,6 @@ impl Instance {
                 )
             }
             None => {
-                self.last_discard = Some((t, h));
                 format!(
                     "{e}; the state is back at the last good time t = {good} s \
                      (lastSuccessfulTime): retry fmi3DoStep from there with a smaller step"
@@ -358,7 +349,7 @@ impl Instance {
             _ => State::StepMode,
         });
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.logger
             .event(&format!("FMU state restored at t = {}", self.engine.time()));
         Ok(())

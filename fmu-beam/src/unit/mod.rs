@@ -11,5 +11,6 @@ pub(crate) mod interface;
 pub(crate) mod log_categories;
 pub(crate) mod memory;
 pub(crate) mod modes;
+pub(crate) mod retry;
 pub(crate) mod shape;
 pub(crate) mod variables;
