@@ -10,8 +10,11 @@ directional derivatives equal the 2.0 unit's; illegal calls, NULL pointers, unkn
 references, wrong value counts and NaN inputs return fmi3Error and change nothing."""
 
 import ctypes
+import shutil
+import struct
 import subprocess
 import zipfile
+from pathlib import Path
 from xml.etree import ElementTree
 
 import numpy as np
@@ -23,6 +26,7 @@ from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3ValueReference
 from fmpy.validation import validate_fmu
 
 from fmu_util import ROOT
+from test_win64 import wine, windows_path  # noqa: F401 (a fixture)
 
 SCENES = sorted(p.stem for p in (ROOT / "scenes").glob("*.toml"))
 # C1-C4 and 3D scenes (one with inputs and a spherical joint: the lower pendulum)
@@ -321,3 +325,55 @@ def test_the_unit_that_ends_early_says_so_through_do_steps_outputs(packaged, tmp
         assert all(np.isfinite(v).all() for v in pair.outputs3().values())
     finally:
         pair.close()
+
+
+WIN64_DLL = ROOT / "target" / "win64" / "x86_64-win7-windows-gnu" / "release" / "fmu_beam.dll"
+MINGW = shutil.which("x86_64-w64-mingw32-gcc")
+
+
+@pytest.mark.skipif(not (WIN64_DLL.is_file() and MINGW and shutil.which("wine")),
+                    reason="no win64 engine, mingw-w64 or Wine (`make win64-tools`, `make win64`)")
+@pytest.mark.parametrize("scene", ["cantilever_free_vibration", "pendulum_3d"])
+def test_the_x86_64_windows_binary_runs_under_wine_as_the_linux_one(harness, wine, scene,
+                                                                     tmp_path):
+    """Packaged with both engines, the 3.0 unit's two binaries meet the same calls from one C
+    importer (tests/c/fmu3_run.c, gcc and mingw-w64): the same outputs bit for bit (C1 and C6
+    agree bit for bit as 2.0 units too, tests/test_win64.py), FMU state reruns bit for bit, the
+    same refusals."""
+    fmu = tmp_path / f"{scene}.fmu"
+    subprocess.run(
+        [harness, "package", ROOT / "scenes" / f"{scene}.toml", "-o", fmu, "--fmi-version", "3",
+         "--binary", ROOT / "target" / "release" / "libfmu_beam.so",
+         "--binary", f"x86_64-windows={WIN64_DLL}"],
+        check=True, capture_output=True,
+    )
+    md = read_model_description(fmu)
+    unzipdir = Path(extract(fmu, unzipdir=tmp_path / "unit"))
+    ident = md.coSimulation.modelIdentifier
+    src = ROOT / "tests" / "c" / "fmu3_run.c"
+    flags = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror"]
+    subprocess.run(["gcc", *flags, "-o", tmp_path / "run", src, "-ldl"], check=True)
+    subprocess.run([MINGW, *flags, "-o", tmp_path / "run.exe", src], check=True)
+    outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Float64"]
+    spec = ",".join(
+        f"{v.valueReference}:{int(v.dimensions[0].start) if v.dimensions else 1}" for v in outputs)
+    h = float(md.defaultExperiment.stepSize)
+    args = [md.guid, "50", struct.pack(">d", h).hex(), spec]
+    resources = unzipdir / "resources"
+    linux = subprocess.run(
+        [tmp_path / "run", unzipdir / "binaries" / "x86_64-linux" / f"{ident}.so",
+         f"{resources}/", *args], capture_output=True, text=True, timeout=120)
+    exe, env = wine
+    windows = subprocess.run(
+        [exe, tmp_path / "run.exe",
+         windows_path(unzipdir / "binaries" / "x86_64-windows" / f"{ident}.dll"),
+         windows_path(resources) + "\\", *args], capture_output=True, text=True, env=env,
+        timeout=300)
+    for run in (linux, windows):
+        assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+        lines = run.stdout.splitlines()
+        assert "rerun 0" in lines and "status short 3" in lines and "status time 3" in lines
+        assert lines[-1] == "done"
+    rows = [[line for line in r.stdout.splitlines() if line.startswith(("row", "state_size"))]
+            for r in (linux, windows)]
+    assert len(rows[0]) == 52 and rows[0] == rows[1]
