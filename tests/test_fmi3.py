@@ -377,3 +377,61 @@ def test_the_x86_64_windows_binary_runs_under_wine_as_the_linux_one(harness, win
     rows = [[line for line in r.stdout.splitlines() if line.startswith(("row", "state_size"))]
             for r in (linux, windows)]
     assert len(rows[0]) == 52 and rows[0] == rows[1]
+
+
+def test_the_python_package_writes_the_same_fmi3_unit(packaged, tmp_path):
+    """`Scene.package(path, fmi_version=3)` writes the bytes `--fmi-version 3` writes."""
+    fmu_beam = pytest.importorskip("fmu_beam")
+    scene = fmu_beam.Scene.load(ROOT / "scenes" / "cantilever_free_vibration.toml")
+    engine = ROOT / "target" / "release" / "libfmu_beam.so"
+    out = tmp_path / "c1.fmu"
+    p = scene.package(out, binaries={"linux64": engine}, fmi_version=3)
+    assert p.model_identifier == "cantilever_free_vibration"
+    assert out.read_bytes() == packaged["cantilever_free_vibration", 3].read_bytes()
+    with pytest.raises(fmu_beam.Error, match="unknown FMI version '4'"):
+        scene.package(tmp_path / "x.fmu", binaries={"linux64": engine}, fmi_version=4)
+    assert not (tmp_path / "x.fmu").exists()
+
+
+# The call-sequence table of the 3.0 unit (co-simulation without event mode): which call each
+# state takes ("ok") or refuses with fmi3Error and a message, changing nothing ("error").
+SEQUENCE = {
+    "Instantiated": dict(enter="ok", exit="error", step="error", get="error", set="ok", terminate="error"),
+    "InitializationMode": dict(enter="error", exit="ok", step="error", get="ok", set="ok", terminate="error"),
+    "StepMode": dict(enter="error", exit="error", step="ok", get="ok", set="ok", terminate="ok"),
+    "Terminated": dict(enter="error", exit="error", step="error", get="ok", set="error", terminate="error"),
+}
+
+
+@pytest.mark.parametrize("state", SEQUENCE)
+def test_each_state_takes_the_calls_of_the_standards_table_and_refuses_the_rest(packaged, state,
+                                                                               tmp_path):
+    path = packaged["cantilever_free_vibration", 3]
+    md = read_model_description(path)
+    tolerance = next(v for v in md.modelVariables if v.name == "solver.tolerance")
+    tip = next(v for v in md.modelVariables if v.name == "beam.tip.y")
+    h = float(md.defaultExperiment.stepSize)
+    calls = {
+        "enter": lambda s: s.enterInitializationMode(),
+        "exit": lambda s: s.exitInitializationMode(),
+        "step": lambda s: s.doStep(0.0 if state != "Terminated" else h, h),
+        "get": lambda s: s.getFloat64([tip.valueReference]),
+        "set": lambda s: s.setFloat64([tolerance.valueReference], [float(tolerance.start)]),
+        "terminate": lambda s: s.terminate(),
+    }
+    for k, (name, expected) in enumerate(SEQUENCE[state].items()):
+        log = Log()
+        s = slave(FMU3Slave, path, md, tmp_path / f"{name}{k}")
+        s.instantiate(logMessage=log)
+        path_to = ["Instantiated", "InitializationMode", "StepMode", "Terminated"]
+        for reached in path_to[1:path_to.index(state) + 1]:
+            {"InitializationMode": calls["enter"], "StepMode": calls["exit"],
+             "Terminated": lambda s: (s.doStep(0.0, h), s.terminate())}[reached](s)
+        if expected == "ok":
+            calls[name](s)
+        else:
+            with pytest.raises(FMICallException) as e:
+                calls[name](s)
+            assert e.value.status == ERROR
+            assert "illegal call sequence" in log.last(), (state, name, log.last())
+        s.freeInstance()
