@@ -1,6 +1,7 @@
 //! The FMI 3.0 co-simulation ABI, called as an importer would, beside the FMI 2.0 ABI on the
 //! same resources (a clamped cantilever, case C1, N = 4): the same run bit for bit, the shape
-//! array equal to 2.0's scalars, an FMU state round trip, refused calls that change nothing,
+//! array equal to 2.0's scalars, an FMU state round trip, refused calls that change nothing, a
+//! discarded step (retry, then terminateSimulation),
 //! the functions it does not provide, and instantiation's refusals.
 
 // Calling the C ABI takes unsafe code: these tests live in `fmi3/`, where the crate allows it.
@@ -451,4 +452,73 @@ fn instantiation_refuses_a_wrong_token_and_event_mode() {
     assert!(log.last().contains("instantiationToken"), "{}", log.last());
     assert!(instantiate(&res, &log, TOKEN, true).is_null());
     assert!(log.last().contains("eventModeUsed"), "{}", log.last());
+}
+
+/// A step over the work budget returns fmi3Discard with the state back at its start
+/// (lastSuccessfulTime, outputs unchanged) and terminateSimulation = false: a retry may pass.
+/// The same step again fails the same way: terminateSimulation = true, StepDiscarded, and only
+/// fmi3Terminate, a state or a reset are left; a state set brings back Step Mode.
+#[test]
+fn a_discarded_step_may_be_retried_and_a_repeated_one_ends_the_run() {
+    let (res, log, table) = (Resources::new(), Log::default(), table());
+    let layout = Layout3::of(&table);
+    let c = initialized(&res, &log);
+    for k in 0..5 {
+        step(c, k as f64 * H);
+    }
+    let good = floats(c, &layout, &table);
+    let mut state: fmi3FMUState = null_mut();
+    let budget = table.by_name("solver.step_budget").unwrap().vr;
+    let long_step = |c| {
+        let (mut e, mut s, mut r, mut last) = (9u8, 9u8, 9u8, f64::NAN);
+        // SAFETY: a live instance, valid outputs.
+        let status =
+            unsafe { fmi3DoStep(c, 5.0 * H, 2.0 * H, 0, &mut e, &mut s, &mut r, &mut last) };
+        (status, e, s, r, last)
+    };
+    // SAFETY: a live instance and state slot.
+    unsafe {
+        assert_eq!(fmi3GetFMUState(c, &mut state), fmi3OK);
+        assert_eq!(fmi3SetInt32(c, &budget, 1, &1, 1), fmi3OK, "{}", log.last());
+    }
+    let (status, event, terminate, early, last) = long_step(c);
+    assert_eq!(
+        (status, event, terminate, early),
+        (fmi3Discard, 0, 0, 0),
+        "{}",
+        log.last()
+    );
+    assert!(
+        (last - 5.0 * H).abs() < 1e-12 && log.last().contains("retry"),
+        "{}",
+        log.last()
+    );
+    assert_eq!(
+        floats(c, &layout, &table),
+        good,
+        "the last good state stays readable"
+    );
+    let (status, _, terminate, _, last) = long_step(c);
+    assert_eq!((status, terminate), (fmi3Discard, 1), "{}", log.last());
+    assert!(
+        log.last().contains("terminateSimulation = true"),
+        "{}",
+        log.last()
+    );
+    assert!((last - 5.0 * H).abs() < 1e-12);
+    assert_eq!(step(c, 5.0 * H).status, fmi3Error, "no step once ended");
+    assert!(
+        log.last().contains("ended the simulation"),
+        "{}",
+        log.last()
+    );
+    assert_eq!(floats(c, &layout, &table), good);
+    // SAFETY: as above.
+    unsafe {
+        assert_eq!(fmi3SetFMUState(c, state), fmi3OK);
+        assert_eq!(step(c, 5.0 * H).status, fmi3OK, "{}", log.last());
+        assert_eq!(fmi3FreeFMUState(c, &mut state), fmi3OK);
+        assert_eq!(fmi3Terminate(c), fmi3OK);
+        fmi3FreeInstance(c);
+    }
 }
