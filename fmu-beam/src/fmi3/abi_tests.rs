@@ -1,8 +1,8 @@
 //! The FMI 3.0 co-simulation ABI, called as an importer would, beside the FMI 2.0 ABI on the
 //! same resources (a clamped cantilever, case C1, N = 4): the same run bit for bit, the shape
 //! array equal to 2.0's scalars, an FMU state round trip, refused calls that change nothing, a
-//! discarded step (retry, then terminateSimulation),
-//! the functions it does not provide, and instantiation's refusals.
+//! discarded step (a retry, then terminateSimulation), the functions it does not provide, and
+//! instantiation's refusals.
 
 // Calling the C ABI takes unsafe code: these tests live in `fmi3/`, where the crate allows it.
 
