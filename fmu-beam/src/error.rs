@@ -287,6 +287,25 @@ impl EngineError {
 }
 
 impl EngineError {
+    /// True for a refused request (an unknown value reference, a value or a call the unit does
+    /// not take): the FMI layers return an error status and leave the instance as it was.
+    pub fn is_refusal(&self) -> bool {
+        matches!(
+            self,
+            EngineError::UnknownValueReference { .. }
+                | EngineError::NotSettable { .. }
+                | EngineError::NonFiniteValue { .. }
+                | EngineError::InvalidValue { .. }
+                | EngineError::BadStep { .. }
+                | EngineError::BadState { .. }
+                | EngineError::Experiment { .. }
+                | EngineError::DirectionalDerivative { .. }
+                | EngineError::FeedthroughSingular { .. }
+        )
+    }
+}
+
+impl EngineError {
     /// The failure itself, without the diagnosis a failed step carries.
     pub fn cause(&self) -> &EngineError {
         match self {

@@ -19,6 +19,7 @@
 
 mod error;
 mod fmi2;
+mod fmi3;
 pub mod integrator;
 pub mod mechanics;
 pub mod scene;
@@ -30,7 +31,6 @@ mod unit;
 extern crate self as fmu_beam;
 
 pub use error::EngineError;
-pub use fmi2::logger::LOG_CATEGORIES;
 /// The FMI 2.0 C types, one definition for the unit (`fmi2`) and fmu-harness's master binding.
 pub use fmi2::types as fmi2_types;
 pub use scene::{Scene, SceneError};
@@ -38,7 +38,9 @@ pub use unit::effects::{resolve as resolve_effects, Decision, Resolution, EFFECT
 pub use unit::engine::Engine;
 pub use unit::interface::explain as explain_feedthrough;
 pub use unit::interface::explain_accuracy;
+pub use unit::log_categories::LOG_CATEGORIES;
 pub use unit::modes::{modes, natural_frequencies, Mode, ModeOptions, Modes};
 pub use unit::variables::{
-    Binding, Causality, Initial, UnitDef, VarType, Variability, Variable, VariableTable, UNITS,
+    Binding, Causality, Declared, Initial, Layout3, UnitDef, VarType, Variability, Variable,
+    Variable3, VariableTable, UNITS,
 };

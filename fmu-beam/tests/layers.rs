@@ -14,7 +14,7 @@ const LAYERS: [(&str, &[&str]); 8] = [
     ("mechanics", &["mechanics"]),
     ("integrator", &["integrator"]),
     ("unit", &["unit"]),
-    ("fmi2", &["fmi2"]),
+    ("fmi", &["fmi2", "fmi3"]),
     ("in-crate tests", &["tests"]),
 ];
 

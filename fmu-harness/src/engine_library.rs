@@ -6,7 +6,7 @@
 //! table) with the `object` crate: nothing of the library is loaded or run to package it.
 
 use crate::error::HarnessError;
-use crate::platform::Platform;
+use crate::platform::{FmiVersion, Platform};
 use object::{Object, ObjectSymbol};
 use std::path::Path;
 
@@ -52,6 +52,94 @@ pub const FMI2_COSIMULATION_FUNCTIONS: [&str; 34] = [
     "fmi2GetStringStatus",
 ];
 
+/// The functions of the FMI 3.0 standard, every one of which the engine exports (issue 47),
+/// also those of interfaces it does not provide (they return fmi3Error with a message).
+pub const FMI3_FUNCTIONS: [&str; 75] = [
+    "fmi3GetVersion",
+    "fmi3SetDebugLogging",
+    "fmi3InstantiateModelExchange",
+    "fmi3InstantiateCoSimulation",
+    "fmi3InstantiateScheduledExecution",
+    "fmi3FreeInstance",
+    "fmi3EnterInitializationMode",
+    "fmi3ExitInitializationMode",
+    "fmi3EnterEventMode",
+    "fmi3Terminate",
+    "fmi3Reset",
+    "fmi3GetFloat32",
+    "fmi3GetFloat64",
+    "fmi3GetInt8",
+    "fmi3GetUInt8",
+    "fmi3GetInt16",
+    "fmi3GetUInt16",
+    "fmi3GetInt32",
+    "fmi3GetUInt32",
+    "fmi3GetInt64",
+    "fmi3GetUInt64",
+    "fmi3GetBoolean",
+    "fmi3GetString",
+    "fmi3GetBinary",
+    "fmi3GetClock",
+    "fmi3SetFloat32",
+    "fmi3SetFloat64",
+    "fmi3SetInt8",
+    "fmi3SetUInt8",
+    "fmi3SetInt16",
+    "fmi3SetUInt16",
+    "fmi3SetInt32",
+    "fmi3SetUInt32",
+    "fmi3SetInt64",
+    "fmi3SetUInt64",
+    "fmi3SetBoolean",
+    "fmi3SetString",
+    "fmi3SetBinary",
+    "fmi3SetClock",
+    "fmi3GetNumberOfVariableDependencies",
+    "fmi3GetVariableDependencies",
+    "fmi3GetFMUState",
+    "fmi3SetFMUState",
+    "fmi3FreeFMUState",
+    "fmi3SerializedFMUStateSize",
+    "fmi3SerializeFMUState",
+    "fmi3DeserializeFMUState",
+    "fmi3GetDirectionalDerivative",
+    "fmi3GetAdjointDerivative",
+    "fmi3EnterConfigurationMode",
+    "fmi3ExitConfigurationMode",
+    "fmi3GetIntervalDecimal",
+    "fmi3GetIntervalFraction",
+    "fmi3GetShiftDecimal",
+    "fmi3GetShiftFraction",
+    "fmi3SetIntervalDecimal",
+    "fmi3SetIntervalFraction",
+    "fmi3SetShiftDecimal",
+    "fmi3SetShiftFraction",
+    "fmi3EvaluateDiscreteStates",
+    "fmi3UpdateDiscreteStates",
+    "fmi3EnterContinuousTimeMode",
+    "fmi3CompletedIntegratorStep",
+    "fmi3SetTime",
+    "fmi3SetContinuousStates",
+    "fmi3GetContinuousStateDerivatives",
+    "fmi3GetEventIndicators",
+    "fmi3GetContinuousStates",
+    "fmi3GetNominalsOfContinuousStates",
+    "fmi3GetNumberOfEventIndicators",
+    "fmi3GetNumberOfContinuousStates",
+    "fmi3EnterStepMode",
+    "fmi3GetOutputDerivatives",
+    "fmi3DoStep",
+    "fmi3ActivateModelPartition",
+];
+
+/// The functions a library must export to be packaged in an FMU of `version`.
+pub fn required_functions(version: FmiVersion) -> &'static [&'static str] {
+    match version {
+        FmiVersion::V2 => &FMI2_COSIMULATION_FUNCTIONS,
+        FmiVersion::V3 => &FMI3_FUNCTIONS,
+    }
+}
+
 /// The bytes of the library at `path`, or why it is refused (not a regular file, too large).
 pub fn read(path: &Path) -> Result<Vec<u8>, HarnessError> {
     Ok(crate::input_file::read(
@@ -67,6 +155,15 @@ pub fn read(path: &Path) -> Result<Vec<u8>, HarnessError> {
 pub fn missing_functions(
     bytes: &[u8],
     platform: Platform,
+) -> Result<Vec<&'static str>, object::Error> {
+    missing_functions_of(bytes, platform, FmiVersion::V2)
+}
+
+/// The functions of [`required_functions`] of `version` that `bytes` does not export.
+pub fn missing_functions_of(
+    bytes: &[u8],
+    platform: Platform,
+    version: FmiVersion,
 ) -> Result<Vec<&'static str>, object::Error> {
     let names: Vec<Vec<u8>> = match platform {
         Platform::Linux64 => {
@@ -84,17 +181,30 @@ pub fn missing_functions(
                 .collect()
         }
     };
-    Ok(FMI2_COSIMULATION_FUNCTIONS
-        .into_iter()
+    Ok(required_functions(version)
+        .iter()
+        .copied()
         .filter(|f| !names.iter().any(|n| n == f.as_bytes()))
         .collect())
 }
 
 /// Refuses a library of `platform` that misses any FMI 2.0 co-simulation function.
 pub fn check_exports(path: &Path, bytes: &[u8], platform: Platform) -> Result<(), HarnessError> {
-    let missing = missing_functions(bytes, platform).map_err(|e| HarnessError::LibrarySymbols {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
+    check_exports_of(path, bytes, platform, FmiVersion::V2)
+}
+
+/// Refuses a library of `platform` that misses any function an FMU of `version` needs.
+pub fn check_exports_of(
+    path: &Path,
+    bytes: &[u8],
+    platform: Platform,
+    version: FmiVersion,
+) -> Result<(), HarnessError> {
+    let missing = missing_functions_of(bytes, platform, version).map_err(|e| {
+        HarnessError::LibrarySymbols {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        }
     })?;
     if missing.is_empty() {
         Ok(())
@@ -102,7 +212,7 @@ pub fn check_exports(path: &Path, bytes: &[u8], platform: Platform) -> Result<()
         Err(HarnessError::MissingFunctions {
             path: path.to_path_buf(),
             count: missing.len(),
-            of: FMI2_COSIMULATION_FUNCTIONS.len(),
+            of: required_functions(version).len(),
             missing,
         })
     }

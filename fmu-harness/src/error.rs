@@ -113,11 +113,17 @@ pub enum HarnessError {
 
 /// Which FMI 2.0 functions a `--binary` does not export.
 fn missing_functions_message(count: usize, of: usize, missing: &[&str]) -> String {
+    // the list names the version: FMI 2.0's co-simulation functions or FMI 3.0's all
+    let which = if missing.first().is_some_and(|f| f.starts_with("fmi3")) {
+        "FMI 3.0"
+    } else {
+        "FMI 2.0 co-simulation"
+    };
     if count == of {
-        format!("exports none of the {of} FMI 2.0 co-simulation functions: not an FMU binary")
+        format!("exports none of the {of} {which} functions: not an FMU binary")
     } else {
         format!(
-            "does not export {count} of the {of} FMI 2.0 co-simulation functions: {}",
+            "does not export {count} of the {of} {which} functions: {}",
             missing.join(", ")
         )
     }

@@ -13,6 +13,8 @@ use quick_xml::name::QName;
 use quick_xml::Writer;
 use std::borrow::Cow;
 
+pub mod fmi3;
+
 /// The FMI 2.0 co-simulation skeleton, compiled in so the harness binary is self-contained.
 pub const TEMPLATE: &str = include_str!("../../modelDescription-templates/fmi2-cosimulation.xml");
 
@@ -24,17 +26,8 @@ pub fn generation_tool() -> String {
 /// The whole modelDescription.xml; `guid` may be empty (the text the GUID is computed from).
 pub fn render(scene: &Scene, table: &VariableTable, guid: &str) -> Result<String, HarnessError> {
     let tool = generation_tool();
-    let defined = table.units();
-    for v in &table.variables {
-        if let Some(unit) = v.unit.filter(|u| !defined.iter().any(|d| d.name == *u)) {
-            return Err(HarnessError::UndefinedUnit {
-                scene: scene.name.clone(),
-                variable: v.name.clone(),
-                unit: unit.to_string(),
-            });
-        }
-    }
-    let units = unit_definitions(&defined)?;
+    check_units(scene, table)?;
+    let units = unit_definitions(&table.units())?;
     let categories = log_categories()?;
     let experiment = default_experiment(&scene.experiment, scene.solver.tolerance)?;
     let variables = model_variables(table)?;
@@ -54,6 +47,21 @@ pub fn render(scene: &Scene, table: &VariableTable, guid: &str) -> Result<String
             ("MODEL_STRUCTURE", Fill::Xml(&structure)),
         ],
     )
+}
+
+/// Refuses a variable whose unit is not one of [`fmu_beam::UNITS`].
+fn check_units(scene: &Scene, table: &VariableTable) -> Result<(), HarnessError> {
+    let defined = table.units();
+    for v in &table.variables {
+        if let Some(unit) = v.unit.filter(|u| !defined.iter().any(|d| d.name == *u)) {
+            return Err(HarnessError::UndefinedUnit {
+                scene: scene.name.clone(),
+                variable: v.name.clone(),
+                unit: unit.to_string(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A real number as its shortest round-trip decimal text (`{:?}`-style), in exponent form when

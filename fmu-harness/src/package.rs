@@ -10,7 +10,7 @@ use crate::engine_library;
 use crate::error::HarnessError;
 use crate::guid::guid;
 use crate::model_description;
-use crate::platform::Platform;
+use crate::platform::{FmiVersion, Platform};
 use fmu_beam::Scene;
 use fmu_beam::VariableTable;
 use std::path::{Path, PathBuf};
@@ -86,19 +86,34 @@ pub fn contents(
     scene: &Scene,
     binaries: &[(Platform, &[u8])],
 ) -> Result<FmuContents, HarnessError> {
+    contents_with(scene, binaries, FmiVersion::V2)
+}
+
+/// [`contents`] of an FMU of `version`: FMI 3.0's model description
+/// ([`model_description::fmi3::render`], its instantiationToken the GUID) and platform folders
+/// in the GUID's input; the same scene text and documentation.
+pub fn contents_with(
+    scene: &Scene,
+    binaries: &[(Platform, &[u8])],
+    version: FmiVersion,
+) -> Result<FmuContents, HarnessError> {
     let table = VariableTable::build(scene);
     let scene_text = canonical_text(scene)?;
-    let unsigned = model_description::render(scene, &table, "")?;
+    let render = match version {
+        FmiVersion::V2 => model_description::render,
+        FmiVersion::V3 => model_description::fmi3::render,
+    };
+    let unsigned = render(scene, &table, "")?;
     let lengths: Vec<[u8; 8]> = binaries
         .iter()
         .map(|(_, b)| (b.len() as u64).to_le_bytes())
         .collect();
     let mut parts: Vec<&[u8]> = vec![unsigned.as_bytes(), scene_text.as_bytes()];
     for ((platform, bytes), length) in binaries.iter().zip(&lengths) {
-        parts.extend([platform.folder().as_bytes(), &length[..], bytes]);
+        parts.extend([platform.folder_in(version).as_bytes(), &length[..], bytes]);
     }
     let guid = guid(&parts);
-    let model_description = model_description::render(scene, &table, &guid)?;
+    let model_description = render(scene, &table, &guid)?;
     Ok(FmuContents {
         model_identifier: scene.name.clone(),
         guid,
@@ -229,11 +244,32 @@ pub fn package(
     package_scene(&Scene::load(scene_path)?, output, binaries)
 }
 
+/// [`package`] as an FMU of `version` (`--fmi-version`).
+pub fn package_as(
+    scene_path: &Path,
+    output: &Path,
+    binaries: &[BinaryArg],
+    version: FmiVersion,
+) -> Result<Packaged, HarnessError> {
+    package_scene_as(&Scene::load(scene_path)?, output, binaries, version)
+}
+
 /// [`package`] of a scene already loaded and validated (the Python package's `Scene.package`).
 pub fn package_scene(
     scene: &Scene,
     output: &Path,
     binaries: &[BinaryArg],
+) -> Result<Packaged, HarnessError> {
+    package_scene_as(scene, output, binaries, FmiVersion::V2)
+}
+
+/// [`package_scene`] as an FMU of `version`: FMI 2.0 or 3.0 from the same engine libraries
+/// (each exports both standards' functions, checked for the one packaged).
+pub fn package_scene_as(
+    scene: &Scene,
+    output: &Path,
+    binaries: &[BinaryArg],
+    version: FmiVersion,
 ) -> Result<Packaged, HarnessError> {
     // an output that would be refused is refused before the work
     crate::output_file::check(output)?;
@@ -260,7 +296,7 @@ pub fn package_scene(
                 })
             }
         };
-        engine_library::check_exports(&arg.path, &bytes, platform)?;
+        engine_library::check_exports_of(&arg.path, &bytes, platform, version)?;
         if let Some((_, first, _)) = libraries.iter().find(|(p, _, _)| *p == platform) {
             return Err(HarnessError::DuplicatePlatform {
                 platform,
@@ -275,13 +311,13 @@ pub fn package_scene(
         .iter()
         .map(|(p, _, b)| (*p, b.as_slice()))
         .collect();
-    let c = contents(scene, &parts)?;
+    let c = contents_with(scene, &parts, version)?;
     let paths: Vec<String> = libraries
         .iter()
         .map(|(p, _, _)| {
             format!(
                 "binaries/{}/{}.{}",
-                p.folder(),
+                p.folder_in(version),
                 c.model_identifier,
                 p.extension()
             )
@@ -369,7 +405,7 @@ pub fn binary_candidates(exe: &Path) -> Vec<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::{binary_candidates, BinaryArg};
-    use crate::platform::Platform;
+    use crate::platform::{FmiVersion, Platform};
     use std::path::{Path, PathBuf};
 
     #[test]
@@ -398,6 +434,28 @@ mod tests {
         assert!(arg("darwin64=x.dylib")
             .unwrap_err()
             .contains("unknown platform 'darwin64'"));
+    }
+
+    /// `--fmi-version`: 2 by default, 3 with FMI 3.0's platform tuples; the `--binary`
+    /// prefixes of either version name the same platforms.
+    #[test]
+    fn fmi_versions_and_their_platform_folders() {
+        assert_eq!(FmiVersion::default(), FmiVersion::V2);
+        assert_eq!("3".parse(), Ok(FmiVersion::V3));
+        assert_eq!("2.0".parse(), Ok(FmiVersion::V2));
+        assert!("4".parse::<FmiVersion>().is_err());
+        let v3: Vec<&str> = Platform::ALL
+            .iter()
+            .map(|p| p.folder_in(FmiVersion::V3))
+            .collect();
+        assert_eq!(v3, ["x86_64-linux", "x86_64-windows"]);
+        assert_eq!(
+            "x86_64-windows=a.dll"
+                .parse::<BinaryArg>()
+                .unwrap()
+                .platform,
+            Some(Platform::Win64)
+        );
     }
 
     #[test]

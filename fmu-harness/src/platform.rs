@@ -6,7 +6,32 @@ mod stand_in;
 
 use std::fmt;
 
-/// A platform folder of FMI 2.0 that the packager fills.
+/// The FMI version of the FMUs the packager writes (`--fmi-version`): 2.0 by default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FmiVersion {
+    /// FMI 2.0 co-simulation: `binaries/linux64`, `binaries/win64`.
+    #[default]
+    V2,
+    /// FMI 3.0 co-simulation: `binaries/x86_64-linux`, `binaries/x86_64-windows` (issue 47).
+    V3,
+}
+
+impl std::str::FromStr for FmiVersion {
+    type Err = String;
+
+    /// `2` or `2.0`, `3` or `3.0`.
+    fn from_str(text: &str) -> Result<FmiVersion, String> {
+        match text {
+            "2" | "2.0" => Ok(FmiVersion::V2),
+            "3" | "3.0" => Ok(FmiVersion::V3),
+            other => Err(format!(
+                "unknown FMI version '{other}' (the packager writes 2 or 3)"
+            )),
+        }
+    }
+}
+
+/// A platform that the packager fills, FMI 2.0's folder names by default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Platform {
     /// x86_64 Linux: an ELF shared object, `.so`.
@@ -27,6 +52,15 @@ impl Platform {
         }
     }
 
+    /// The folder under `binaries/` in an FMU of `version` (FMI 3.0's platform tuples).
+    pub fn folder_in(self, version: FmiVersion) -> &'static str {
+        match (version, self) {
+            (FmiVersion::V2, p) => p.folder(),
+            (FmiVersion::V3, Platform::Linux64) => "x86_64-linux",
+            (FmiVersion::V3, Platform::Win64) => "x86_64-windows",
+        }
+    }
+
     /// The shared library's file extension.
     pub fn extension(self) -> &'static str {
         match self {
@@ -35,9 +69,11 @@ impl Platform {
         }
     }
 
-    /// The platform of a folder name (`linux64`, `win64`).
+    /// The platform of a folder name of either version (`linux64`, `x86_64-linux`, ...).
     pub fn from_folder(name: &str) -> Option<Platform> {
-        Platform::ALL.into_iter().find(|p| p.folder() == name)
+        Platform::ALL
+            .into_iter()
+            .find(|p| p.folder() == name || p.folder_in(FmiVersion::V3) == name)
     }
 
     /// What a library of this platform is, for messages.

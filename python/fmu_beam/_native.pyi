@@ -144,10 +144,12 @@ class Scene:
         path: StrPath,
         platforms: Optional[Sequence[str]] = None,
         binaries: Optional[Mapping[str, StrPath]] = None,
+        fmi_version: int = 2,
     ) -> Packaged:
         """Writes the scene's FMU to ``path`` with this package's engines of ``platforms``
         ('linux64', 'win64'; default: all it carries), or with the engine libraries of
-        ``binaries`` ({'linux64': path, ...}, like ``--binary``). ``path`` must be a new name
+        ``binaries`` ({'linux64': path, ...}, like ``--binary``), as an FMI 2.0 unit or, with
+        ``fmi_version=3``, an FMI 3.0 one (docs/fmi-versions.md). ``path`` must be a new name
         or a regular file, replaced whole; a FIFO, device, directory or symbolic link there is
         refused (:class:`Error`) and left as it was."""
     def simulate(

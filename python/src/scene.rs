@@ -6,7 +6,7 @@ use crate::engines;
 use crate::errors::{guard, harness_err, Refusal};
 use fmu_beam::Scene;
 use fmu_harness::package::{self, BinaryArg};
-use fmu_harness::platform::Platform;
+use fmu_harness::platform::{FmiVersion, Platform};
 use fmu_harness::HarnessError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -235,18 +235,25 @@ impl PyScene {
 
     /// Writes the scene's FMU to `path` with the engines of `platforms` ('linux64', 'win64';
     /// default: every engine this package carries, see fmu_beam.engines()), or with the engine
-    /// libraries of `binaries` ({'linux64': path, ...}, like `--binary`). Returns what it
-    /// wrote.
-    #[pyo3(signature = (path, platforms = None, binaries = None))]
+    /// libraries of `binaries` ({'linux64': path, ...}, like `--binary`), as an FMI 2.0 unit
+    /// or (`fmi_version=3`) an FMI 3.0 one. Returns what it wrote.
+    #[pyo3(signature = (path, platforms = None, binaries = None, fmi_version = 2))]
     fn package(
         &self,
         py: Python<'_>,
         path: PathBuf,
         platforms: Option<Vec<String>>,
         binaries: Option<BTreeMap<String, PathBuf>>,
+        fmi_version: u32,
     ) -> PyResult<Packaged> {
+        let version = fmi_version
+            .to_string()
+            .parse::<FmiVersion>()
+            .map_err(crate::errors::Error::new_err)?;
         let args = engine_args(platforms, binaries)?;
-        let p = detached(py, || package::package_scene(&self.scene, &path, &args))?;
+        let p = detached(py, || {
+            package::package_scene_as(&self.scene, &path, &args, version)
+        })?;
         Ok(Packaged {
             path: p.output.display().to_string(),
             model_identifier: p.model_identifier,

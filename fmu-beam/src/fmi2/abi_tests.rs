@@ -1230,10 +1230,7 @@ fn debug_logging_categories() {
         fmi2OK,
         "all categories"
     );
-    let all_categories: Vec<&str> = crate::fmi2::logger::LOG_CATEGORIES
-        .iter()
-        .map(|(n, _)| *n)
-        .collect();
+    let all_categories: Vec<&str> = crate::LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
     assert!(all_categories.contains(&"logAll") && all_categories.contains(&"logStatusError"));
 }
 

@@ -63,7 +63,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// The FMI 2.0 standard's contract for this function.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    unsafe { guard_free(c) }
+    unsafe { guard_free::<Instance>(c) }
 }
 
 /// # Safety

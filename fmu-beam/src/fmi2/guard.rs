@@ -44,6 +44,42 @@ impl From<EngineError> for Fault {
     }
 }
 
+/// An instance as the guard sees it: FMI 2.0's [`Instance`] here, FMI 3.0's in `fmi3/` (the
+/// two standards' status values agree, 0 to 4, so the guard speaks in `fmi2Status`).
+pub trait Guarded {
+    /// The functions that take an instance.
+    type Call: Copy;
+    /// Refuses a call that is illegal in the instance's state (nothing changes).
+    fn check(&self, call: Self::Call) -> Result<(), Fault>;
+    /// The C name of a call, for messages.
+    fn name(call: Self::Call) -> &'static str;
+    /// Sends the message of a call that returns `status`.
+    fn report(&self, status: fmi2Status, message: &str);
+    /// After a panic: the instance moves to its error state; says what the master may call.
+    fn panicked(&mut self) -> &'static str;
+}
+
+impl Guarded for Instance {
+    type Call = Call;
+
+    fn check(&self, call: Call) -> Result<(), Fault> {
+        check(self.state, call)
+    }
+
+    fn name(call: Call) -> &'static str {
+        call.name()
+    }
+
+    fn report(&self, status: fmi2Status, message: &str) {
+        self.logger.status(status, message);
+    }
+
+    fn panicked(&mut self) -> &'static str {
+        self.state = ModelState::Error;
+        "call fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance"
+    }
+}
+
 /// Runs `f` on the instance behind `c` if `call` is legal in its state.
 ///
 /// # Safety
@@ -54,33 +90,47 @@ pub unsafe fn guard(
     call: Call,
     f: impl FnOnce(&mut Instance) -> Result<(), Fault>,
 ) -> fmi2Status {
+    // SAFETY: the same contract.
+    unsafe { guard_with(c, call, f) }
+}
+
+/// [`guard`] for an instance of type `I`.
+///
+/// # Safety
+/// `c` is NULL or points to a live `I` made by the instantiate function of `I`'s layer, used
+/// by one thread at a time.
+pub unsafe fn guard_with<I: Guarded>(
+    c: *mut std::os::raw::c_void,
+    call: I::Call,
+    f: impl FnOnce(&mut I) -> Result<(), Fault>,
+) -> fmi2Status {
     if c.is_null() {
         // No instance, so no logger to tell.
         return fmi2Status::fmi2Error;
     }
     // SAFETY: see the contract above.
-    let instance = unsafe { &mut *c.cast::<Instance>() };
+    let instance = unsafe { &mut *c.cast::<I>() };
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        check(instance.state, call)?;
+        instance.check(call)?;
         f(instance)
     }));
     match outcome {
         Ok(Ok(())) => fmi2Status::fmi2OK,
         Ok(Err(fault)) => {
-            instance
-                .logger
-                .status(fault.status, &format!("{}: {}", call.name(), fault.message));
+            instance.report(
+                fault.status,
+                &format!("{}: {}", I::name(call), fault.message),
+            );
             fault.status
         }
         Err(payload) => {
-            instance.state = ModelState::Error;
+            let next = instance.panicked();
             let message = format!(
-                "{}: internal error (Rust panic: {}); the instance is now in state Error: \
-                 call fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance",
-                call.name(),
+                "{}: internal error (Rust panic: {}); the instance is now in state Error: {next}",
+                I::name(call),
                 panic_text(&*payload)
             );
-            instance.logger.status(fmi2Status::fmi2Error, &message);
+            instance.report(fmi2Status::fmi2Error, &message);
             fmi2Status::fmi2Error
         }
     }
@@ -112,22 +162,23 @@ pub unsafe fn guard_instantiate(
     std::ptr::null_mut()
 }
 
-/// fmi2FreeInstance: drops the instance (NULL is ignored).
+/// fmi2FreeInstance (and fmi3FreeInstance, with `I` its instance): drops the instance (NULL is
+/// ignored).
 ///
 /// # Safety
-/// As for [`guard`]; `c` is not used again.
-pub unsafe fn guard_free(c: fmi2Component) {
+/// As for [`guard_with`]; `c` came from `Box::into_raw` and is not used again.
+pub unsafe fn guard_free<I>(c: *mut std::os::raw::c_void) {
     if c.is_null() {
         return;
     }
-    // SAFETY: `c` came from `Box::into_raw` in `guard_instantiate`.
-    let instance = unsafe { Box::from_raw(c.cast::<Instance>()) };
+    // SAFETY: `c` came from `Box::into_raw` of an `I` (`guard_instantiate` or fmi3's).
+    let instance = unsafe { Box::from_raw(c.cast::<I>()) };
     // A panic while dropping is swallowed: there is nobody left to tell.
     let _ = catch_unwind(AssertUnwindSafe(move || drop(instance)));
 }
 
 /// The message a panic was raised with.
-fn panic_text(payload: &(dyn Any + Send)) -> &str {
+pub fn panic_text(payload: &(dyn Any + Send)) -> &str {
     payload
         .downcast_ref::<&str>()
         .copied()

@@ -29,6 +29,7 @@ use super::types::{
 };
 use crate::error::EngineError;
 use crate::unit::engine::Engine;
+use crate::unit::retry::Retry;
 use crate::unit::variables::VarType;
 
 pub struct Instance {
@@ -37,8 +38,8 @@ pub struct Instance {
     engine: Engine,
     /// Why the unit cannot continue (fmi2Terminated = true), set with `StepFailed`.
     ended: Option<String>,
-    /// The (t, h) of the last step that failed with a Discard a retry may overcome.
-    last_discard: Option<(f64, f64)>,
+    /// Whether a failed step may be retried.
+    retry: Retry,
     /// The tolerance the master passed to fmi2SetupExperiment (toleranceDefined), if any.
     master_tolerance: Option<f64>,
 }
@@ -84,27 +85,15 @@ impl Instance {
             state: ModelState::Instantiated,
             engine: Engine::new(scene),
             ended: None,
-            last_discard: None,
+            retry: Retry::default(),
             master_tolerance: None,
         })
     }
 
     /// Maps an engine error to a fault and moves the call-sequence state as the failure says.
     fn fail(&mut self, e: EngineError) -> Fault {
-        use EngineError as E;
-        let refused = matches!(
-            e,
-            E::UnknownValueReference { .. }
-                | E::NotSettable { .. }
-                | E::NonFiniteValue { .. }
-                | E::InvalidValue { .. }
-                | E::BadStep { .. }
-                | E::BadState { .. }
-                | E::Experiment { .. }
-                | E::DirectionalDerivative { .. }
-                | E::FeedthroughSingular { .. }
-        );
-        if let E::BadStep { message } = e {
+        let refused = e.is_refusal();
+        if let EngineError::BadStep { message } = e {
             // The engine's text starts with "doStep: "; the guard names the function already.
             return Fault::refused(message);
         }
@@ -239,7 +228,7 @@ impl Instance {
     pub fn reset(&mut self) -> Result<(), Fault> {
         self.engine.reset();
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.master_tolerance = None;
         self.transition(ModelState::Instantiated);
         Ok(())
@@ -316,7 +305,7 @@ impl Instance {
         }
         match result {
             Ok(()) => {
-                self.last_discard = None;
+                self.retry.clear();
                 Ok(())
             }
             Err(e) if e.is_discard() && self.state == ModelState::StepComplete => {
@@ -331,16 +320,7 @@ impl Instance {
     /// the step that failed; then the unit ends the simulation (fmi2Terminated = true).
     fn discard(&mut self, e: EngineError, t: f64, h: f64) -> Fault {
         let good = self.engine.time();
-        let why = if e.ends_run() {
-            Some("a smaller step cannot get past this")
-        } else if self.last_discard == Some((t, h)) {
-            Some(
-                "the master repeated the step that failed, with the same size; the unit is \
-                 deterministic, so it fails the same way (a retry needs a smaller step)",
-            )
-        } else {
-            None
-        };
+        let why = self.retry.judge(&e, t, h);
         let message = match why {
             Some(why) => {
                 self.ended = Some(format!("{e}; {why}"));
@@ -351,7 +331,6 @@ impl Instance {
                 )
             }
             None => {
-                self.last_discard = Some((t, h));
                 format!(
                     "{e}; the state is back at the last good time t = {good} s \
                      (fmi2LastSuccessfulTime): retry fmi2DoStep from there with a smaller step"
@@ -382,7 +361,7 @@ impl Instance {
         }
         self.transition(s.model_state());
         self.ended = None;
-        self.last_discard = None;
+        self.retry.clear();
         self.logger
             .event(&format!("FMU state restored at t = {}", self.engine.time()));
         Ok(())

@@ -25,7 +25,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Package a scene file as an FMI 2.0 co-simulation FMU.
+    /// Package a scene file as an FMI 2.0 (or, `--fmi-version 3`, 3.0) co-simulation FMU.
     Package {
         /// The scene file (TOML).
         scene: PathBuf,
@@ -39,6 +39,10 @@ pub enum Command {
         /// the one beside this executable; Linux only].
         #[arg(long)]
         binary: Vec<package::BinaryArg>,
+        /// The FMI version of the FMU: 2 (the widest reach) or 3 (shape outputs as arrays,
+        /// platform tuples; docs/fmi-versions.md).
+        #[arg(long, default_value = "2")]
+        fmi_version: crate::platform::FmiVersion,
     },
     /// Print the effects the scene's unit simulates, why, and their estimated share of the
     /// cost (the text the FMU carries in documentation/).
@@ -161,9 +165,10 @@ pub fn run_with_engines(
             scene,
             output,
             binary,
+            fmi_version,
         } => {
             let binary = if binary.is_empty() { engines } else { &binary };
-            package_cmd(&scene, &output, binary, out)
+            package_cmd(&scene, &output, binary, fmi_version, out)
         }
         Command::Simulate {
             fmu,
@@ -222,9 +227,10 @@ fn package_cmd(
     scene: &Path,
     output: &Path,
     binary: &[package::BinaryArg],
+    version: crate::platform::FmiVersion,
     out: &mut dyn Write,
 ) -> Result<(), HarnessError> {
-    let p = package::package(scene, output, binary)?;
+    let p = package::package_as(scene, output, binary, version)?;
     let engines: Vec<String> = p
         .binaries
         .iter()

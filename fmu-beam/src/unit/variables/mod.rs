@@ -1,7 +1,10 @@
 //! The variable table of a scene: the single source of the engine's get/set and of the
 //! ModelVariables, UnitDefinitions and ModelStructure that the packager writes.
 
+mod arrays;
 mod build;
+
+pub use arrays::{Declared, Layout3, Variable3};
 
 use crate::scene::Scene;
 use crate::unit::effects::Effects;
