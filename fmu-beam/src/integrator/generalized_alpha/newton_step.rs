@@ -242,8 +242,10 @@ impl Stepper {
                     // a matrix that contracts slowly (it was evaluated at a predictor far from
                     // the solution, or steps ago) is evaluated again at the current iterate,
                     // close to the solution: Newton's own quadratic convergence; so is one
-                    // whose remaining corrections cost more than a new one
-                    let pays = || self.refresh_pays(norm, kappa, n + m);
+                    // evaluated for this step, at its predictor, whose remaining corrections
+                    // cost more than a new one (a matrix kept from earlier steps is judged by
+                    // its rate: `STALE`)
+                    let pays = || fresh && self.refresh_pays(norm, kappa, n + m);
                     if k > 2
                         && refreshed < MAX_REFRESH
                         && (self.memory.contraction.stalls() || pays())
