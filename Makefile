@@ -71,6 +71,11 @@ win64-tools:
 	  || echo "win64-tools: could not install them" >&2; \
 	fi
 
+# The Rust tests of `make test`: cargo-nextest where installed (the test binaries side by side),
+# else cargo test.
+CARGO_TEST := $(if $(shell cargo nextest --version 2>/dev/null),cargo nextest run --no-fail-fast \
+  --cargo-quiet,cargo test --no-fail-fast) --workspace --exclude fmu-beam-py --release
+
 # The workspace but the Python extension, which `wheel` builds (maturin, for an explicit target).
 release:
 	cargo build --release --workspace --exclude fmu-beam-py
@@ -115,21 +120,24 @@ fmus: release win64
 # glibc 2.28's (`auditwheel show dist/*.whl` says which tag the wheel deserves). The linux64 engine
 # must be linked so too; maturin's cargo build makes it on the way (fmu-beam is a cdylib too), so a
 # first pass builds everything, the engine is copied in, and a second pass (nothing left to
-# compile) packs the wheel. The win64 engine is `make win64`'s, made (or waited for: `make test`
-# builds it in the background) after the first pass, which compiles every dependency again for
-# the explicit target and so fills the cores while the Windows build ends. The wheel is then
+# compile) packs the wheel. It builds in $(WHEEL_DIR), apart from target/: it compiles every
+# dependency again for the explicit target anyway, and apart it takes no lock the Linux build
+# holds, so `make test` runs its first pass in the background from the start. The win64 engine
+# is `make win64`'s, made (or waited for) after the first pass. The wheel is then
 # installed into .venv (its dependencies are requirements.txt's), where the tests of the Python
 # API import it.
 WHEEL_ENGINES := python/fmu_beam/engines
 WHEEL_TARGET  := x86_64-unknown-linux-gnu
-MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" nice $(VENV)/bin/maturin build --release \
-  --zig --compatibility manylinux_2_28
+WHEEL_DIR     := target/wheel
+MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" CARGO_TARGET_DIR=$(WHEEL_DIR) nice \
+  $(VENV)/bin/maturin build --release --zig --compatibility manylinux_2_28
 wheel: .venv
 	rm -rf $(WHEEL_ENGINES) build/wheel/first dist/fmu_beam-*.whl
 	$(MATURIN) --out build/wheel/first
+	rm -rf build/wheel/prebuild
 	$(MAKE) --no-print-directory win64
 	mkdir -p $(WHEEL_ENGINES)/linux64
-	cp target/$(WHEEL_TARGET)/release/deps/libfmu_beam.so $(WHEEL_ENGINES)/linux64/
+	cp $(WHEEL_DIR)/$(WHEEL_TARGET)/release/deps/libfmu_beam.so $(WHEEL_ENGINES)/linux64/
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  mkdir -p $(WHEEL_ENGINES)/win64 && cp $(WIN64_ENGINE) $(WHEEL_ENGINES)/win64/; fi
 	$(MATURIN) --out dist
@@ -183,12 +191,16 @@ demo: .venv fmus
 	$(PY) tests/demo.py
 	$(PY) tests/demo_animations.py
 
-# The Windows engine builds in the background (log: build/win64/build.log) while the Linux
-# build and the Rust tests run; the wheel's first pass fills the cores while it ends, then waits
-# for it (cargo's lock on $(WIN64_DIR)), and `fmus` finds it built.
-# pytest runs in two processes side by side: tests/test_no_leaks.py (1e4 cycles under
-# valgrind, 3.5 min on one core; its own --basetemp, its output after the rest's) and the rest
-# (3 min): 3.4 min in all, where one after the other took 7.2 in the last CI (2026-11-29).
+# What runs side by side, so that a fresh clone's `make test` keeps both cores busy (issue 46
+# item 6): the Windows engine (log: build/win64/build.log) and the wheel's first pass (log:
+# build/wheel/prebuild.log; its own $(WHEEL_DIR), so no cargo lock is shared with the Linux
+# build) compile niced in the background from the start, while the Linux build and the Rust
+# tests run in front; `wheel` then waits for both (cargo's locks) and finds them built.
+# The Rust tests run under cargo-nextest where it is installed (every test binary side by side;
+# `cargo test` runs them one after the other and the long single tests leave a core idle).
+# pytest runs in three processes: tests/test_no_leaks.py (1e4 cycles under valgrind, 2 min on
+# one core; its own --basetemp, its output after the rest's) and the rest in two workers
+# (pytest-xdist, a file's tests in one worker: its module fixtures are built once).
 # The fuzz stage runs last, shorter than `make fuzz` alone (issue 45 item 9: a couple of
 # minutes), its two halves side by side (each is one process, bounded in time; outputs in
 # build/fuzz.log and build/fuzz-python.log, shown after both).
@@ -199,16 +211,18 @@ test: .venv tools browser win64-tools
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  echo "win64: building the Windows engine in the background (build/win64/build.log)"; \
 	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
-	fi
+	fi; \
+	mkdir -p build/wheel; echo "wheel: its first pass in the background (build/wheel/prebuild.log)"; \
+	$(MATURIN) --out build/wheel/prebuild </dev/null >build/wheel/prebuild.log 2>&1 &
 	$(MAKE) --no-print-directory release
-	cargo test --workspace --exclude fmu-beam-py --release --no-fail-fast
+	$(CARGO_TEST)
 	$(MAKE) --no-print-directory wheel
 	$(MAKE) --no-print-directory fmus
 	@mkdir -p build; \
 	$(PY) -m pytest tests/test_no_leaks.py -q -p no:cacheprovider --basetemp=build/pytest-leaks \
 	  >build/pytest-leaks.log 2>&1 & leaks=$$!; \
 	echo "pytest: tests/test_no_leaks.py in the background (build/pytest-leaks.log)"; \
-	rest=0; WIN64=$(WIN64) $(PY) -m pytest tests -q --ignore=tests/test_no_leaks.py || rest=$$?; \
+	rest=0; WIN64=$(WIN64) $(PY) -m pytest tests -q -n 2 --dist loadfile --ignore=tests/test_no_leaks.py || rest=$$?; \
 	leaked=0; wait $$leaks || leaked=$$?; \
 	echo "pytest tests/test_no_leaks.py:"; cat build/pytest-leaks.log; \
 	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS) >build/fuzz.log 2>&1 & fuzz=$$!; \
