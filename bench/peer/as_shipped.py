@@ -6,8 +6,8 @@ For each C2-C4 scene: its packaged FMU (build/fmus/<scene>.fmu) run by fmpy.simu
 its own DefaultExperiment and solver settings, as a user runs it; its outputs scored against
 the exact reference (bench/reference/<case>.csv) on the FMU's own output grid (error = max over
 the grid of |y - y_ref| / max |y_ref|, y_ref interpolated linearly where the grids differ); then
-Exudyn's cheapest run in build/bench/peer_points.csv (`sweep.py`) whose error is at most ours,
-re-run here. Ours and Exudyn's runs alternate (ours, Exudyn's, ours, ...) so that both see the
+Exudyn's cheapest run in build/bench/peer_points.csv (`sweep.py`) whose error ON THE SAME GRID
+(the FMU's) is at most ours, re-run here (`cheapest_peer`). Ours and Exudyn's runs alternate (ours, Exudyn's, ours, ...) so that both see the
 same load on a shared machine.
 
 Our time is the process CPU time of the whole call a user makes, in two forms:
@@ -86,17 +86,44 @@ def peer_points(path):
         return [r for r in csv.DictReader(f) if r['tool'] == 'exudyn']
 
 
-def cheapest_peer(points, case, column, error):
-    """Exudyn's cheapest run whose error is at most `error`; where none is, its most accurate
-    run, marked `best`: more accurate runs would cost it at least as much if its cost grows
-    with accuracy, so the ratio against it is then an upper bound."""
+def peer_error_on(run, column, t, ref):
+    """A peer run's error on the grid `t` (ours): its output at those times (its own grid holds
+    them; interpolated linearly where it does not) against the reference there."""
+    y = np.interp(t, run.t, run.outputs[column])
+    y_ref = np.interp(t, ref['t'], ref[column])
+    return float(np.max(np.abs(y - y_ref)) / np.max(np.abs(ref[column])))
+
+
+def cheapest_peer(points, case, column, error, t=None, ref=None):
+    """Exudyn's cheapest run whose error is at most `error` on OUR output grid `t`; where none
+    is, its most accurate run, marked `best`: more accurate runs would cost it at least as much
+    if its cost grows with accuracy, so the ratio against it is then an upper bound.
+
+    The sweep scores the peer on the reference's grid (1e-3 s on C2 and C3), finer than a
+    shipped unit's 1e-2 s: a maximum over ten times the points is larger, so a run that misses
+    our error there may meet it on our grid (the issue-46 run found Exudyn's crank 2, rod 4 at
+    1e-3 s as accurate as slider_crank on a 2e-2 s grid, where this bench had held it to 1e-3 s
+    points). A run whose sweep error meets ours meets it on any coarser grid of its points; each
+    cheaper run is re-run here and scored on our grid (`t`, `ref`), cheapest first."""
     runs = [p for p in points if p['case'] == case and p['output'] == column
             and np.isfinite(float(p['error']))]
-    ok = [p for p in runs if float(p['error']) <= error]
-    if ok:
-        return dict(min(ok, key=lambda p: float(p['cpu_median'])), best=False)
     if not runs:
         return None
+    runs.sort(key=lambda p: float(p['cpu_median']))
+    ok = [p for p in runs if float(p['error']) <= error]
+    bound = float(ok[0]['cpu_median']) if ok else float('inf')
+    if t is not None:
+        for p in runs:
+            if float(p['cpu_median']) >= bound:
+                break
+            run = ec.run(case, **parse_setting(p['setting']))
+            if run.outputs is None:
+                continue
+            on_ours = peer_error_on(run, column, t, ref)
+            if on_ours <= error:
+                return dict(p, error=on_ours, best=False, rescored=True)
+    if ok:
+        return dict(ok[0], best=False)
     return dict(min(runs, key=lambda p: float(p['error'])), best=True)
 
 
@@ -105,6 +132,7 @@ def row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir, theirs):
                ours_fmu=statistics.median(ours_fmu), ours_extracted=statistics.median(ours_dir),
                peer_setting=(peer['setting'] + (' (its most accurate: ratio an upper bound)'
                                                  if peer['best'] else '')
+                             + (' (scored on our grid)' if peer.get('rescored') else '')
                              if peer else 'no run in the sweep'),
                peer_error=float(peer['error']) if peer else float('nan'),
                peer_cpu=statistics.median(theirs) if theirs else float('nan'))
@@ -151,7 +179,8 @@ def main():
             _, result = cpu(lambda: fmpy.simulate_fmu(fmu))
             for column, how in scored:
                 error = score(result, how, ref, column)
-                peer = cheapest_peer(points, case, column, error)
+                t_ours = np.asarray(result['time'], dtype=float)
+                peer = cheapest_peer(points, case, column, error, t_ours, ref)
                 peer_args = parse_setting(peer['setting']) if peer else None
                 ours_fmu, ours_dir, theirs = [], [], []
                 for _ in range(args.repeats):
