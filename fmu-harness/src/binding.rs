@@ -308,19 +308,22 @@ mod tests {
 
     #[test]
     fn a_state_of_one_instance_is_refused_to_another() {
-        let (a, b) = (1usize as *mut c_void, 2usize as *mut c_void);
+        let (mut x, mut y, mut z) = (0u8, 0u8, 0u8);
+        let a = &mut x as *mut u8 as *mut c_void;
+        let b = &mut y as *mut u8 as *mut c_void;
+        let made = &mut z as *mut u8 as *mut c_void;
         let mut state = FmuState::empty();
         assert_eq!(state.set(a, |_| 0), Err(Refusal::ForeignState));
         assert_eq!(state.free(a, |_| 0), Ok(None));
         let got = state.get(a, |p| {
             // SAFETY: p is the state's own field.
-            unsafe { *p = 8usize as *mut c_void };
+            unsafe { *p = made };
             0
         });
         assert_eq!(got, Ok(0));
         assert_eq!(state.set(b, |_| 0), Err(Refusal::ForeignState));
         assert_eq!(state.get(b, |_| 0), Err(Refusal::ForeignState));
-        assert_eq!(state.set(a, |p| p as usize as RawStatus), Ok(8));
+        assert_eq!(state.set(a, |p| (p == made) as RawStatus), Ok(1));
         let freed = state.free(a, |p| {
             // SAFETY: p is the state's own field.
             unsafe { *p = std::ptr::null_mut() };
