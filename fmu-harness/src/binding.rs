@@ -284,6 +284,82 @@ impl FmuState {
     }
 }
 
+/// `fmi2GetFMUstate` / `fmi3GetFMUState` and the free functions: the same C type in both.
+pub type GetStateFn = unsafe extern "C" fn(*mut c_void, *mut *mut c_void) -> RawStatus;
+/// `fmi2SetFMUstate` / `fmi3SetFMUState`.
+pub type SetStateFn = unsafe extern "C" fn(*mut c_void, *mut c_void) -> RawStatus;
+
+/// The FMU-state functions of a library (get, set, free: each `None` when not exported), with
+/// their names for [`Refusal::NotExported`]; one implementation for both versions.
+pub(crate) struct StateFunctions {
+    get: Option<GetStateFn>,
+    set: Option<SetStateFn>,
+    free: Option<GetStateFn>,
+    names: [&'static str; 3],
+}
+
+impl StateFunctions {
+    /// The functions `names` (get, set, free) of `library`.
+    ///
+    /// # Safety
+    /// The names are the FMU-state functions of an FMI standard, whose C types are
+    /// [`GetStateFn`] and [`SetStateFn`]; the pointers are used only while `library` is loaded.
+    pub(crate) unsafe fn load(library: &libloading::Library, names: [&'static str; 3]) -> Self {
+        // SAFETY: the caller's contract.
+        unsafe {
+            StateFunctions {
+                get: symbol(library, names[0]),
+                set: symbol(library, names[1]),
+                free: symbol(library, names[2]),
+                names,
+            }
+        }
+    }
+
+    /// GetFMUState of `instance` into `state` (empty, or one of `instance`'s).
+    ///
+    /// # Safety
+    /// `instance` is live, of the library these functions come from.
+    pub(crate) unsafe fn get(
+        &self,
+        instance: *mut c_void,
+        state: &mut FmuState,
+    ) -> Result<RawStatus, Refusal> {
+        let f = self.get.ok_or(Refusal::NotExported(self.names[0]))?;
+        // SAFETY: the caller's contract; the pointer holds NULL or a state of `instance`.
+        state.get(instance, |p| unsafe { f(instance, p) })
+    }
+
+    /// SetFMUState of `instance` to `state`, one of its own.
+    ///
+    /// # Safety
+    /// As for [`StateFunctions::get`].
+    pub(crate) unsafe fn set(
+        &self,
+        instance: *mut c_void,
+        state: &FmuState,
+    ) -> Result<RawStatus, Refusal> {
+        let f = self.set.ok_or(Refusal::NotExported(self.names[1]))?;
+        // SAFETY: the caller's contract; a state of `instance`.
+        state.set(instance, |p| unsafe { f(instance, p) })
+    }
+
+    /// FreeFMUState: `None` for an empty state; the state is empty afterwards if the FMU set it
+    /// to NULL.
+    ///
+    /// # Safety
+    /// As for [`StateFunctions::get`].
+    pub(crate) unsafe fn free(
+        &self,
+        instance: *mut c_void,
+        state: &mut FmuState,
+    ) -> Result<Option<RawStatus>, Refusal> {
+        let f = self.free.ok_or(Refusal::NotExported(self.names[2]))?;
+        // SAFETY: the caller's contract; a state of `instance`.
+        state.free(instance, |p| unsafe { f(instance, p) })
+    }
+}
+
 /// The array lengths of a get or set, checked: a caller's bug otherwise (it panics, naming
 /// `function`).
 pub(crate) fn same_length(function: &str, a: usize, b: usize) {

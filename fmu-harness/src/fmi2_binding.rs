@@ -27,7 +27,7 @@ use std::os::raw::c_void;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-use crate::binding::{push_message, required, same_length, symbol, take_messages};
+use crate::binding::{push_message, required, same_length, symbol, take_messages, StateFunctions};
 /// `fmi2Status` as the master receives it (not the unit's `fmi2Status` enum of
 /// [`fmu_beam::fmi2_types`]), and what both bindings share.
 pub use crate::binding::{FmuState, LoadError, LogMessage, LogSink, RawStatus, Refusal, Status};
@@ -124,9 +124,6 @@ pub type fmi2SetBooleanTYPE = unsafe extern "C" fn(
     usize,
     *const fmi2Boolean,
 ) -> RawStatus;
-pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
-pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> RawStatus;
-pub type fmi2FreeFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
 pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
@@ -195,9 +192,8 @@ pub struct Api {
     set_integer: fmi2SetIntegerTYPE,
     set_boolean: fmi2SetBooleanTYPE,
     do_step: fmi2DoStepTYPE,
-    get_fmu_state: Option<fmi2GetFMUstateTYPE>,
-    set_fmu_state: Option<fmi2SetFMUstateTYPE>,
-    free_fmu_state: Option<fmi2FreeFMUstateTYPE>,
+    /// Get, set and free FMU state (each optional).
+    states: StateFunctions,
     set_real_input_derivatives: Option<fmi2SetRealInputDerivativesTYPE>,
     get_directional_derivative: Option<fmi2GetDirectionalDerivativeTYPE>,
     get_real_status: Option<fmi2GetRealStatusTYPE>,
@@ -247,9 +243,13 @@ impl Api {
             set_integer: required!("fmi2SetInteger", fmi2SetIntegerTYPE),
             set_boolean: required!("fmi2SetBoolean", fmi2SetBooleanTYPE),
             do_step: required!("fmi2DoStep", fmi2DoStepTYPE),
-            get_fmu_state: optional!("fmi2GetFMUstate", fmi2GetFMUstateTYPE),
-            set_fmu_state: optional!("fmi2SetFMUstate", fmi2SetFMUstateTYPE),
-            free_fmu_state: optional!("fmi2FreeFMUstate", fmi2FreeFMUstateTYPE),
+            // SAFETY: the FMI 2.0 standard's FMU-state functions.
+            states: unsafe {
+                StateFunctions::load(
+                    &library,
+                    ["fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"],
+                )
+            },
             set_real_input_derivatives: optional!(
                 "fmi2SetRealInputDerivatives",
                 fmi2SetRealInputDerivativesTYPE
@@ -501,33 +501,19 @@ impl Instance {
 
     /// `fmi2GetFMUstate`: fills an empty `state` or overwrites one of this instance.
     pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .get_fmu_state
-            .ok_or(Refusal::NotExported("fmi2GetFMUstate"))?;
-        // SAFETY: a live component; the pointer holds NULL or a state of this component.
-        let s = state.get(self.component, |p| unsafe { f(self.component, p) })?;
-        Ok(Status::from_c(s))
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.get(self.component, state) }.map(Status::from_c)
     }
 
     pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .set_fmu_state
-            .ok_or(Refusal::NotExported("fmi2SetFMUstate"))?;
-        // SAFETY: a state of this component.
-        let s = state.set(self.component, |p| unsafe { f(self.component, p) })?;
-        Ok(Status::from_c(s))
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.set(self.component, state) }.map(Status::from_c)
     }
 
     /// `fmi2FreeFMUstate`; the state is empty afterwards if the FMU set it to NULL.
     pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .free_fmu_state
-            .ok_or(Refusal::NotExported("fmi2FreeFMUstate"))?;
-        // SAFETY: a state of this component.
-        let s = state.free(self.component, |p| unsafe { f(self.component, p) })?;
+        // SAFETY: a live instance of the library.
+        let s = unsafe { self.api.states.free(self.component, state) }?;
         Ok(s.map_or(Status::Ok, Status::from_c))
     }
 }

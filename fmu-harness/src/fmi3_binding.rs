@@ -13,7 +13,7 @@
 
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
-use crate::binding::{push_message, required, symbol, take_messages};
+use crate::binding::{push_message, required, symbol, take_messages, StateFunctions};
 pub use crate::binding::{FmuState, LoadError, LogMessage, LogSink, RawStatus, Refusal, Status};
 pub use fmu_beam::fmi3_types::{
     fmi3Boolean, fmi3FMUState, fmi3False, fmi3Float64, fmi3Instance, fmi3InstanceEnvironment,
@@ -72,9 +72,6 @@ pub type fmi3DoStepTYPE = unsafe extern "C" fn(
     *mut fmi3Boolean,
     *mut fmi3Float64,
 ) -> RawStatus;
-pub type fmi3GetFMUStateTYPE = unsafe extern "C" fn(fmi3Instance, *mut fmi3FMUState) -> RawStatus;
-pub type fmi3SetFMUStateTYPE = unsafe extern "C" fn(fmi3Instance, fmi3FMUState) -> RawStatus;
-pub type fmi3FreeFMUStateTYPE = unsafe extern "C" fn(fmi3Instance, *mut fmi3FMUState) -> RawStatus;
 pub type fmi3GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
     fmi3Instance,
     *const fmi3ValueReference,
@@ -115,9 +112,8 @@ pub struct Api {
     set_int32: fmi3SetTYPE<fmi3Int32>,
     set_boolean: fmi3SetTYPE<fmi3Boolean>,
     do_step: fmi3DoStepTYPE,
-    get_fmu_state: Option<fmi3GetFMUStateTYPE>,
-    set_fmu_state: Option<fmi3SetFMUStateTYPE>,
-    free_fmu_state: Option<fmi3FreeFMUStateTYPE>,
+    /// Get, set and free FMU state (each optional).
+    states: StateFunctions,
     get_directional_derivative: Option<fmi3GetDirectionalDerivativeTYPE>,
     // Last: the function pointers above are only valid while the library is loaded.
     _library: libloading::Library,
@@ -155,9 +151,13 @@ impl Api {
             set_int32: required!("fmi3SetInt32"),
             set_boolean: required!("fmi3SetBoolean"),
             do_step: required!("fmi3DoStep"),
-            get_fmu_state: optional!("fmi3GetFMUState"),
-            set_fmu_state: optional!("fmi3SetFMUState"),
-            free_fmu_state: optional!("fmi3FreeFMUState"),
+            // SAFETY: the FMI 3.0 standard's FMU-state functions.
+            states: unsafe {
+                StateFunctions::load(
+                    &library,
+                    ["fmi3GetFMUState", "fmi3SetFMUState", "fmi3FreeFMUState"],
+                )
+            },
             get_directional_derivative: optional!("fmi3GetDirectionalDerivative"),
             _library: library,
         }))
@@ -354,33 +354,19 @@ impl Instance {
 
     /// `fmi3GetFMUState`: fills an empty `state` or overwrites one of this instance.
     pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .get_fmu_state
-            .ok_or(Refusal::NotExported("fmi3GetFMUState"))?;
-        // SAFETY: a live instance; the pointer holds NULL or a state of this instance.
-        let s = state.get(self.instance, |p| unsafe { f(self.instance, p) })?;
-        Ok(Status::from_c3(s))
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.get(self.instance, state) }.map(Status::from_c3)
     }
 
     pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .set_fmu_state
-            .ok_or(Refusal::NotExported("fmi3SetFMUState"))?;
-        // SAFETY: a state of this instance.
-        let s = state.set(self.instance, |p| unsafe { f(self.instance, p) })?;
-        Ok(Status::from_c3(s))
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.set(self.instance, state) }.map(Status::from_c3)
     }
 
     /// `fmi3FreeFMUState`; the state is empty afterwards if the FMU set it to NULL.
     pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .free_fmu_state
-            .ok_or(Refusal::NotExported("fmi3FreeFMUState"))?;
-        // SAFETY: a state of this instance.
-        let s = state.free(self.instance, |p| unsafe { f(self.instance, p) })?;
+        // SAFETY: a live instance of the library.
+        let s = unsafe { self.api.states.free(self.instance, state) }?;
         Ok(s.map_or(Status::Ok, Status::from_c3))
     }
 }
