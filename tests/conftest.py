@@ -2,6 +2,7 @@
 harness binary are, and C1 instances driven through fmpy as a user of the FMU would."""
 
 import os
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -65,3 +66,30 @@ def new_instance(c1_unzipped):
     yield make
     for inst in made:
         inst.close()
+
+
+class Packaged:
+    """{(scene, version): FMU path}: a shipped scene packaged as an FMI 2.0 or 3.0 unit with the
+    release engine, on first use, once per session (both versions from one engine)."""
+
+    def __init__(self, harness, out):
+        self.harness, self.out, self.paths = harness, out, {}
+
+    def __getitem__(self, key):
+        scene, version = key
+        if key not in self.paths:
+            path = self.out / f"{scene}.v{version}.fmu"
+            subprocess.run(
+                [self.harness, "package", ROOT / "scenes" / f"{scene}.toml", "-o", path,
+                 "--binary", ROOT / "target" / "release" / "libfmu_beam.so",
+                 "--fmi-version", str(version)],
+                check=True, capture_output=True,
+            )
+            self.paths[key] = path
+        return self.paths[key]
+
+
+@pytest.fixture(scope="session")
+def packaged(tmp_path_factory, harness):
+    """Shipped scenes as FMI 2.0 and 3.0 units: `packaged[scene, version]` is the FMU's path."""
+    return Packaged(harness, tmp_path_factory.mktemp("units_by_version"))

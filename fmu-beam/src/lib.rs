@@ -33,6 +33,8 @@ extern crate self as fmu_beam;
 pub use error::EngineError;
 /// The FMI 2.0 C types, one definition for the unit (`fmi2`) and fmu-harness's master binding.
 pub use fmi2::types as fmi2_types;
+/// The FMI 3.0 C types, one definition for the unit (`fmi3`) and fmu-harness's master binding.
+pub use fmi3::types as fmi3_types;
 pub use scene::{Scene, SceneError};
 pub use unit::effects::{resolve as resolve_effects, Decision, Resolution, EFFECTS};
 pub use unit::engine::Engine;

@@ -11,10 +11,8 @@
 //! array lengths passed to C are the slice lengths; an [`FmuState`] is only ever handed back to
 //! the instance that made it.
 //!
-//! Over 600 lines: the binding mirrors the C API one function to one method, and splitting
-//! it would spread the unsafe code that this one file is meant to hold.
-//!
-//! Over 600 lines on purpose: all of the crate's unsafe code, in one file to be reviewed as one.
+//! What both versions' bindings share (the status, the log sink, the FMU state's owner checks,
+//! the symbol look-up) is [`crate::binding`]'s; FMI 3.0's binding is [`crate::fmi3_binding`].
 
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
@@ -25,14 +23,14 @@ pub use fmu_beam::fmi2_types::{
 };
 pub use fmu_beam::fmi2_types::{fmi2LastSuccessfulTime, fmi2Terminated};
 use std::ffi::CStr;
-use std::os::raw::{c_int, c_void};
+use std::os::raw::c_void;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-/// `fmi2Status` as the master receives it: a plain `c_int`, not the unit's `fmi2Status` enum of
-/// [`fmu_beam::fmi2_types`] (a Rust enum must never hold a value outside its variants, and a
-/// foreign FMU may return any integer); [`Status::from_c`] reads it.
-pub type RawStatus = c_int;
+use crate::binding::{push_message, required, same_length, symbol, take_messages, StateFunctions};
+/// `fmi2Status` as the master receives it (not the unit's `fmi2Status` enum of
+/// [`fmu_beam::fmi2_types`]), and what both bindings share.
+pub use crate::binding::{FmuState, LoadError, LogMessage, LogSink, RawStatus, Refusal, Status};
 
 /// `fmi2CallbackLogger` without its variadic tail. C declares it `(env, name, status, category,
 /// message, ...)`; a stable Rust `extern "C" fn` cannot be variadic, so the master's logger takes
@@ -126,9 +124,6 @@ pub type fmi2SetBooleanTYPE = unsafe extern "C" fn(
     usize,
     *const fmi2Boolean,
 ) -> RawStatus;
-pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
-pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> RawStatus;
-pub type fmi2FreeFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> RawStatus;
 pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
     fmi2Component,
     *const fmi2ValueReference,
@@ -157,72 +152,8 @@ extern "C" {
     fn free(obj: *mut c_void);
 }
 
-/// `fmi2Status` as returned; a value outside the standard's range is kept as `Unknown`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Status {
-    Ok,
-    Warning,
-    Discard,
-    Error,
-    Fatal,
-    Pending,
-    Unknown(c_int),
-}
-
-impl Status {
-    pub fn from_c(s: RawStatus) -> Self {
-        match s {
-            0 => Status::Ok,
-            1 => Status::Warning,
-            2 => Status::Discard,
-            3 => Status::Error,
-            4 => Status::Fatal,
-            5 => Status::Pending,
-            other => Status::Unknown(other),
-        }
-    }
-
-    /// fmi2OK or fmi2Warning: the call did what was asked.
-    pub fn is_success(self) -> bool {
-        matches!(self, Status::Ok | Status::Warning)
-    }
-
-    /// The status a logger callback received (the same numbering).
-    fn name(self) -> &'static str {
-        match self {
-            Status::Ok => "fmi2OK",
-            Status::Warning => "fmi2Warning",
-            Status::Discard => "fmi2Discard",
-            Status::Error => "fmi2Error",
-            Status::Fatal => "fmi2Fatal",
-            Status::Pending => "fmi2Pending",
-            Status::Unknown(_) => "unknown status",
-        }
-    }
-}
-
-impl std::fmt::Display for Status {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Status::Unknown(v) => write!(f, "unknown status {v}"),
-            s => f.write_str(s.name()),
-        }
-    }
-}
-
-/// One call of the FMU's logger.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LogMessage {
-    pub status: Status,
-    pub category: String,
-    pub message: String,
-}
-
-/// Where the logger callback of one instance puts its messages.
-pub type LogSink = Mutex<Vec<LogMessage>>;
-
-/// The master's logger: appends to the instance's [`LogSink`] (the component environment).
-/// Must not unwind into C: every step that could panic is inside `catch_unwind`.
+/// The master's logger: appends to the instance's [`LogSink`] (the component environment),
+/// the message formatted as printf prints it without arguments.
 unsafe extern "C" fn log_message(
     env: fmi2ComponentEnvironment,
     _instance_name: fmi2String,
@@ -230,29 +161,9 @@ unsafe extern "C" fn log_message(
     category: fmi2String,
     message: fmi2String,
 ) {
-    let text = |p: fmi2String| {
-        if p.is_null() {
-            String::new()
-        } else {
-            // SAFETY: the FMU passes NUL-terminated strings valid for the call.
-            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-        }
-    };
-    if env.is_null() {
-        return;
-    }
-    // SAFETY: env is the `LogSink` of the instance, kept alive until after fmi2FreeInstance.
-    let sink = unsafe { &*(env as *const LogSink) };
-    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let entry = LogMessage {
-            status: Status::from_c(status),
-            category: text(category),
-            message: crate::log_format::printf(&text(message)),
-        };
-        if let Ok(mut v) = sink.lock() {
-            v.push(entry);
-        }
-    }));
+    // SAFETY: env is the instance's LogSink, kept alive until after fmi2FreeInstance; the FMU
+    // passes NUL-terminated strings valid for the call.
+    unsafe { push_message(env, Status::from_c(status), category, message, true) }
 }
 
 unsafe extern "C" fn allocate_memory(nobj: usize, size: usize) -> *mut c_void {
@@ -263,18 +174,6 @@ unsafe extern "C" fn allocate_memory(nobj: usize, size: usize) -> *mut c_void {
 unsafe extern "C" fn free_memory(obj: *mut c_void) {
     // SAFETY: obj came from allocate_memory (or is NULL), as the standard requires.
     unsafe { free(obj) }
-}
-
-/// A required or optional function that the library does not export.
-#[derive(Debug, thiserror::Error)]
-pub enum LoadError {
-    #[error("cannot load {path}: {source}")]
-    Open {
-        path: String,
-        source: libloading::Error,
-    },
-    #[error("{path} does not export {symbol}")]
-    Missing { path: String, symbol: &'static str },
 }
 
 /// The fmi2 functions of one loaded library. Optional ones are `None` when not exported.
@@ -293,9 +192,8 @@ pub struct Api {
     set_integer: fmi2SetIntegerTYPE,
     set_boolean: fmi2SetBooleanTYPE,
     do_step: fmi2DoStepTYPE,
-    get_fmu_state: Option<fmi2GetFMUstateTYPE>,
-    set_fmu_state: Option<fmi2SetFMUstateTYPE>,
-    free_fmu_state: Option<fmi2FreeFMUstateTYPE>,
+    /// Get, set and free FMU state (each optional).
+    states: StateFunctions,
     set_real_input_derivatives: Option<fmi2SetRealInputDerivativesTYPE>,
     get_directional_derivative: Option<fmi2GetDirectionalDerivativeTYPE>,
     get_real_status: Option<fmi2GetRealStatusTYPE>,
@@ -310,27 +208,18 @@ impl Api {
     /// Loading runs the library's initializers; an FMU's binary is trusted code of the master's
     /// choosing, as in every FMI importer.
     pub fn load(path: &Path) -> Result<Arc<Api>, LoadError> {
-        let shown = path.display().to_string();
-        // SAFETY: see above: loading an FMU's library is running its code.
-        let library =
-            unsafe { libloading::Library::new(path) }.map_err(|source| LoadError::Open {
-                path: shown.clone(),
-                source,
-            })?;
+        let library = crate::binding::open(path)?;
         macro_rules! optional {
             ($name:literal, $ty:ty) => {
-                // SAFETY: the symbol has the C type the FMI standard gives it.
-                unsafe { library.get::<$ty>(concat!($name, "\0").as_bytes()) }
-                    .ok()
-                    .map(|s| *s)
+                // SAFETY: the symbol has the C type the FMI standard gives it; the pointer is
+                // kept with the library.
+                unsafe { symbol::<$ty>(&library, $name) }
             };
         }
         macro_rules! required {
             ($name:literal, $ty:ty) => {
-                optional!($name, $ty).ok_or_else(|| LoadError::Missing {
-                    path: shown.clone(),
-                    symbol: $name,
-                })?
+                // SAFETY: as for `optional!`.
+                unsafe { required::<$ty>(&library, path, $name) }?
             };
         }
         Ok(Arc::new(Api {
@@ -354,9 +243,13 @@ impl Api {
             set_integer: required!("fmi2SetInteger", fmi2SetIntegerTYPE),
             set_boolean: required!("fmi2SetBoolean", fmi2SetBooleanTYPE),
             do_step: required!("fmi2DoStep", fmi2DoStepTYPE),
-            get_fmu_state: optional!("fmi2GetFMUstate", fmi2GetFMUstateTYPE),
-            set_fmu_state: optional!("fmi2SetFMUstate", fmi2SetFMUstateTYPE),
-            free_fmu_state: optional!("fmi2FreeFMUstate", fmi2FreeFMUstateTYPE),
+            // SAFETY: the FMI 2.0 standard's FMU-state functions.
+            states: unsafe {
+                StateFunctions::load(
+                    &library,
+                    ["fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"],
+                )
+            },
             set_real_input_derivatives: optional!(
                 "fmi2SetRealInputDerivatives",
                 fmi2SetRealInputDerivativesTYPE
@@ -370,35 +263,6 @@ impl Api {
             _library: library,
         }))
     }
-}
-
-/// An FMU state made by [`Instance::get_fmu_state`]; tagged with its instance so that it is never
-/// handed to another one.
-#[derive(Debug)]
-pub struct FmuState {
-    pointer: fmi2FMUstate,
-    owner: fmi2Component,
-}
-
-impl FmuState {
-    /// No state yet: `fmi2GetFMUstate` allocates a new one.
-    pub fn empty() -> Self {
-        FmuState {
-            pointer: std::ptr::null_mut(),
-            owner: std::ptr::null_mut(),
-        }
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.pointer.is_null()
-    }
-}
-
-/// A function the library does not export, or a state of another instance.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Refusal {
-    NotExported(&'static str),
-    ForeignState,
 }
 
 /// One co-simulation instance: the component and what C holds pointers to.
@@ -442,9 +306,7 @@ impl Instance {
             )
         };
         if component.is_null() {
-            return Err(std::mem::take(
-                &mut *log.lock().unwrap_or_else(|e| e.into_inner()),
-            ));
+            return Err(take_messages(&log));
         }
         Ok(Instance {
             component,
@@ -456,7 +318,7 @@ impl Instance {
 
     /// The messages logged since the last call of this function.
     pub fn take_messages(&self) -> Vec<LogMessage> {
-        std::mem::take(&mut *self.log.lock().unwrap_or_else(|e| e.into_inner()))
+        take_messages(&self.log)
     }
 
     pub fn setup_experiment(
@@ -531,11 +393,7 @@ impl Instance {
 
     /// `fmi2GetReal`; panics if the slices differ in length (a bug of the caller).
     pub fn get_real(&mut self, vr: &[fmi2ValueReference], values: &mut [f64]) -> Status {
-        assert_eq!(
-            vr.len(),
-            values.len(),
-            "fmi2GetReal: vr and values differ in length"
-        );
+        same_length("fmi2GetReal", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.get_real)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
@@ -543,7 +401,7 @@ impl Instance {
     }
 
     pub fn get_integer(&mut self, vr: &[fmi2ValueReference], values: &mut [i32]) -> Status {
-        assert_eq!(vr.len(), values.len(), "fmi2GetInteger: lengths differ");
+        same_length("fmi2GetInteger", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.get_integer)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
@@ -552,7 +410,7 @@ impl Instance {
 
     /// `fmi2GetBoolean`, values as the C `fmi2Boolean` (int).
     pub fn get_boolean(&mut self, vr: &[fmi2ValueReference], values: &mut [i32]) -> Status {
-        assert_eq!(vr.len(), values.len(), "fmi2GetBoolean: lengths differ");
+        same_length("fmi2GetBoolean", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.get_boolean)(self.component, vr.as_ptr(), vr.len(), values.as_mut_ptr())
@@ -560,7 +418,7 @@ impl Instance {
     }
 
     pub fn set_real(&mut self, vr: &[fmi2ValueReference], values: &[f64]) -> Status {
-        assert_eq!(vr.len(), values.len(), "fmi2SetReal: lengths differ");
+        same_length("fmi2SetReal", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.set_real)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
@@ -568,7 +426,7 @@ impl Instance {
     }
 
     pub fn set_integer(&mut self, vr: &[fmi2ValueReference], values: &[i32]) -> Status {
-        assert_eq!(vr.len(), values.len(), "fmi2SetInteger: lengths differ");
+        same_length("fmi2SetInteger", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.set_integer)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
@@ -577,7 +435,7 @@ impl Instance {
 
     /// `fmi2SetBoolean`, values as the C `fmi2Boolean` (int).
     pub fn set_boolean(&mut self, vr: &[fmi2ValueReference], values: &[i32]) -> Status {
-        assert_eq!(vr.len(), values.len(), "fmi2SetBoolean: lengths differ");
+        same_length("fmi2SetBoolean", vr.len(), values.len());
         // SAFETY: both arrays hold vr.len() elements.
         Status::from_c(unsafe {
             (self.api.set_boolean)(self.component, vr.as_ptr(), vr.len(), values.as_ptr())
@@ -643,51 +501,20 @@ impl Instance {
 
     /// `fmi2GetFMUstate`: fills an empty `state` or overwrites one of this instance.
     pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .get_fmu_state
-            .ok_or(Refusal::NotExported("fmi2GetFMUstate"))?;
-        if !state.is_empty() && state.owner != self.component {
-            return Err(Refusal::ForeignState);
-        }
-        // SAFETY: state.pointer is NULL or a state of this component.
-        let s = Status::from_c(unsafe { f(self.component, &mut state.pointer) });
-        if !state.pointer.is_null() {
-            state.owner = self.component;
-        }
-        Ok(s)
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.get(self.component, state) }.map(Status::from_c)
     }
 
     pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .set_fmu_state
-            .ok_or(Refusal::NotExported("fmi2SetFMUstate"))?;
-        if state.is_empty() || state.owner != self.component {
-            return Err(Refusal::ForeignState);
-        }
-        // SAFETY: a state of this component.
-        Ok(Status::from_c(unsafe { f(self.component, state.pointer) }))
+        // SAFETY: a live instance of the library.
+        unsafe { self.api.states.set(self.component, state) }.map(Status::from_c)
     }
 
     /// `fmi2FreeFMUstate`; the state is empty afterwards if the FMU set it to NULL.
     pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, Refusal> {
-        let f = self
-            .api
-            .free_fmu_state
-            .ok_or(Refusal::NotExported("fmi2FreeFMUstate"))?;
-        if state.is_empty() {
-            return Ok(Status::Ok);
-        }
-        if state.owner != self.component {
-            return Err(Refusal::ForeignState);
-        }
-        // SAFETY: a state of this component.
-        let s = Status::from_c(unsafe { f(self.component, &mut state.pointer) });
-        if state.pointer.is_null() {
-            state.owner = std::ptr::null_mut();
-        }
-        Ok(s)
+        // SAFETY: a live instance of the library.
+        let s = unsafe { self.api.states.free(self.component, state) }?;
+        Ok(s.map_or(Status::Ok, Status::from_c))
     }
 }
 

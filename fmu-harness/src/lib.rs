@@ -1,6 +1,7 @@
-//! fmu-harness: turns a scene file into an FMI 2.0 co-simulation FMU, reports a scene's
-//! linearized natural frequencies, and runs FMI 2.0 co-simulation FMUs (any, not only ours)
-//! through [`slave::Slave`] over the raw binding [`fmi2_binding`] (the crate's only unsafe code).
+//! fmu-harness: turns a scene file into an FMI 2.0 (or 3.0) co-simulation FMU, reports a scene's
+//! linearized natural frequencies, and runs FMI 2.0 and 3.0 co-simulation FMUs (any, not only
+//! ours) through [`slave::Slave`] over the raw bindings [`fmi2_binding`] and [`fmi3_binding`]
+//! (with what they share, [`binding`]: the crate's only unsafe code).
 //!
 //! Data flow of `package`: [`fmu_beam::Scene`] → [`fmu_beam::VariableTable`] →
 //! [`model_description::render`] (the template in `modelDescription-templates/`) →
@@ -9,6 +10,8 @@
 pub mod accuracy;
 pub mod animate;
 pub mod archive;
+#[allow(unsafe_code)]
+pub mod binding;
 pub mod chart;
 pub mod cli;
 pub mod cosim;
@@ -16,6 +19,8 @@ pub mod engine_library;
 pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi2_binding;
+#[allow(unsafe_code)]
+pub mod fmi3_binding;
 pub mod guid;
 pub mod input_file;
 pub mod log_categories;

@@ -44,8 +44,15 @@ impl Platform {
     /// Every platform, in the order of the FMU's entries and of the GUID's input.
     pub const ALL: [Platform; 2] = [Platform::Linux64, Platform::Win64];
 
-    /// The folder under `binaries/`.
-    pub fn folder(self) -> &'static str {
+    /// The platform of the machine this program runs on: the binaries the master loads.
+    pub const HOST: Platform = if cfg!(windows) {
+        Platform::Win64
+    } else {
+        Platform::Linux64
+    };
+
+    /// The folder under `binaries/` (FMI 2.0's name).
+    pub const fn folder(self) -> &'static str {
         match self {
             Platform::Linux64 => "linux64",
             Platform::Win64 => "win64",

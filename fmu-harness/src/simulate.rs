@@ -1,13 +1,17 @@
 //! `fmu-harness simulate`: one co-simulation unit run through [`Slave`] with a fixed
 //! communication step, the chosen variables recorded at every communication point.
 //!
-//! The loop is fmpy's `simulate_fmu` for FMI 2.0 CS, so that both give the same calls:
-//! `fmi2SetupExperiment(tolerance of DefaultExperiment if any, start, stop)`, communication points
-//! start + (n+1)·h, the last step shortened to land on the stop time, the run ends when t is
-//! within 1e-9 relative of the stop time.
+//! The loop is fmpy's `simulate_fmu` for FMI 2.0 and 3.0 CS, so that both give the same calls:
+//! `fmi2SetupExperiment(tolerance of DefaultExperiment if any, start, stop)` (FMI 3.0: the same
+//! arguments to fmi3EnterInitializationMode), communication points start + (n+1)·h, the last
+//! step shortened to land on the stop time, the run ends when t is within 1e-9 relative of the
+//! stop time. An FMI 3.0 array is recorded as one column per element, named as FMI 2.0 names
+//! the scalars (`beam.shape.x[1]`), so the CSVs of a scene's 2.0 and 3.0 units compare line by
+//! line.
 //!
-//! fmi2Discard (FMI 2.0 §4.2.3): when the FMU says it cannot go on (fmi2Terminated), the run
-//! ends cleanly at its last good time (fmi2LastSuccessfulTime), recorded as the last row, and
+//! Discard (FMI 2.0 §4.2.3, FMI 3.0 §4.2.4): when the FMU says it cannot go on (fmi2Terminated,
+//! fmi3DoStep's terminateSimulation), the run ends cleanly at its last good time
+//! (fmi2LastSuccessfulTime, fmi3DoStep's lastSuccessfulTime), recorded as the last row, and
 //! [`simulate_into`] returns [`Ended`] with the FMU's messages (`fmu-harness simulate` exits
 //! with status 3). Otherwise the step is retried from the last good time in halves, at most
 //! [`MAX_HALVINGS`] times, before the run fails. Here the master differs from fmpy, which
@@ -18,7 +22,8 @@
 //! them ([`Results`]). A run is refused before it starts when it would take more than
 //! [`MAX_COMMUNICATION_STEPS`] steps (a `stepSize="1e-300"` of a hostile FMU).
 
-use crate::fmi2_binding::{LogMessage, Status};
+use crate::binding::{LogMessage, Status};
+use crate::platform::FmiVersion;
 use crate::slave::{Slave, SlaveError, VarType, Variable};
 use std::io::Write;
 use std::path::Path;
@@ -31,7 +36,7 @@ pub const MAX_COMMUNICATION_STEPS: f64 = 1e8;
 /// 10, a step down to 1/1024 of the communication step.
 pub const MAX_HALVINGS: u32 = 10;
 
-/// A run that the FMU ended before the stop time (fmi2Discard, then fmi2Terminated = true).
+/// A run that the FMU ended before the stop time (Discard, and the FMU asked to terminate).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ended {
     /// The FMU's last good time, the last row's (s).
@@ -46,7 +51,7 @@ impl std::fmt::Display for Ended {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "the FMU ended the simulation at t = {} s of {} s (fmi2Discard, fmi2Terminated); \
+            "the FMU ended the simulation at t = {} s of {} s (Discard, and it asked to terminate); \
              every row up to that time is recorded",
             self.time, self.stop
         )?;
@@ -175,24 +180,58 @@ fn record(slave: &mut Slave, t: f64, vars: &[Variable]) -> Result<Vec<f64>, Slav
     let mut row = Vec::with_capacity(vars.len() + 1);
     row.push(t);
     for v in vars {
-        let vr = [v.value_reference];
-        let x = match v.var_type {
-            VarType::Real => slave.get_real(&vr)?[0],
-            VarType::Integer | VarType::Enumeration => slave.get_integer(&vr)?[0] as f64,
-            VarType::Boolean => f64::from(u8::from(slave.get_boolean(&vr)?[0])),
-            VarType::String => f64::NAN,
-        };
-        row.push(x);
+        read_into(slave, v, &mut row)?;
     }
     Ok(row)
+}
+
+/// Appends the values of `v` (one for a scalar, an FMI 3.0 array's elements in order) to `row`
+/// as numbers: Integer, Enumeration and Boolean too; NaN for what is no number.
+pub fn read_into(slave: &mut Slave, v: &Variable, row: &mut Vec<f64>) -> Result<(), SlaveError> {
+    let vr = [v.value_reference];
+    match v.var_type {
+        VarType::Real => row.extend(slave.get_real(&vr)?),
+        VarType::Integer | VarType::Enumeration => {
+            row.extend(slave.get_integer(&vr)?.into_iter().map(f64::from))
+        }
+        VarType::Boolean => row.extend(
+            slave
+                .get_boolean(&vr)?
+                .into_iter()
+                .map(|b| f64::from(u8::from(b))),
+        ),
+        VarType::String | VarType::Other(_) => {
+            row.extend(std::iter::repeat_n(f64::NAN, v.value_count()))
+        }
+    }
+    Ok(())
+}
+
+/// The column names and types of the recorded variables: an FMI 3.0 array's elements one
+/// column each, named as FMI 2.0 names them (`beam.shape.x[1]`).
+pub fn columns(vars: &[Variable]) -> (Vec<String>, Vec<VarType>) {
+    let mut names = Vec::new();
+    let mut types = Vec::new();
+    for v in vars {
+        let c = v.columns();
+        types.extend(std::iter::repeat_n(v.var_type, c.len()));
+        names.extend(c);
+    }
+    (names, types)
 }
 
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
     #[error(transparent)]
     Slave(#[from] SlaveError),
-    #[error("`{name}` is a String variable: the CSV holds numbers only")]
-    StringVariable { name: String },
+    #[error(
+        "`{name}` is a {type_name} variable: the CSV holds numbers only (Real or Float64, \
+         Integer or Int32, Boolean, FMI 2.0's Enumeration)"
+    )]
+    StringVariable {
+        name: String,
+        type_name: &'static str,
+    },
     #[error(
         "bad experiment: start {start}, stop {stop}, step {step} (need stop > start, step > 0)"
     )]
@@ -262,9 +301,10 @@ pub fn simulate_into(
             .map(|n| md.variable(n).cloned())
             .collect::<Result<_, _>>()?
     };
-    if let Some(v) = vars.iter().find(|v| v.var_type == VarType::String) {
+    if let Some(v) = vars.iter().find(|v| !v.var_type.is_numeric()) {
         return Err(SimulateError::StringVariable {
             name: v.name.clone(),
+            type_name: v.var_type.name(md.fmi_version),
         });
     }
 
@@ -273,8 +313,7 @@ pub fn simulate_into(
     slave.enter_initialization_mode()?;
     slave.exit_initialization_mode()?;
     pass_warnings(&mut slave, options);
-    let names: Vec<String> = vars.iter().map(|v| v.name.clone()).collect();
-    let types: Vec<VarType> = vars.iter().map(|v| v.var_type).collect();
+    let (names, types) = columns(&vars);
     sink.columns(&names, &types)
         .map_err(SimulateError::Output)?;
     sink.row(&record(&mut slave, start, &vars)?)
@@ -347,7 +386,10 @@ fn advance(
                 }
                 if halvings == MAX_HALVINGS {
                     return Err(SimulateError::Slave(SlaveError::Call {
-                        function: "fmi2DoStep",
+                        function: match slave.model_description.fmi_version {
+                            FmiVersion::V2 => "fmi2DoStep",
+                            FmiVersion::V3 => "fmi3DoStep",
+                        },
                         status: Status::Discard,
                         messages,
                     }));

@@ -1,7 +1,8 @@
 //! `fmu-harness package --binary` reads with care (issue 35, items 2 and 8): a character device
 //! (`/dev/zero`), a FIFO or a folder is refused before it is read, by its type and at once; a
 //! file over the size cap is refused; a library that exports no FMI 2.0 function, or not all
-//! of them, is refused naming what is missing. Each run is bounded in time: a hang fails.
+//! of them, is refused naming what is missing; so is one without the FMI 3.0 functions for a
+//! `--fmi-version 3` unit. Each run is bounded in time: a hang fails.
 
 mod common;
 use common::*;
@@ -12,6 +13,11 @@ use std::time::Duration;
 
 /// `fmu-harness package C1 -o <dir>/x.fmu --binary <binary>` within 20 s: (success, stderr).
 fn package_with(dir: &Path, binary: &str) -> (bool, String, Duration) {
+    package_as(dir, binary, "2")
+}
+
+/// [`package_with`] as an FMI `version` unit (`--fmi-version`).
+fn package_as(dir: &Path, binary: &str, version: &str) -> (bool, String, Duration) {
     let err = dir.join("stderr.txt");
     let out = dir.join("x.fmu");
     let child = Command::new(env!("CARGO_BIN_EXE_fmu-harness"))
@@ -19,7 +25,7 @@ fn package_with(dir: &Path, binary: &str) -> (bool, String, Duration) {
         .arg(c1_path())
         .arg("-o")
         .arg(&out)
-        .args(["--binary", binary])
+        .args(["--binary", binary, "--fmi-version", version])
         .stdout(Stdio::null())
         .stderr(std::fs::File::create(&err).unwrap())
         .spawn()
@@ -125,5 +131,30 @@ fn a_library_without_fmi2_exports_is_refused() {
     // The engine itself passes.
     let engine = fmu_harness::package::default_binary().expect("the release engine is built");
     let (ok, stderr, _) = package_with(&dir, &engine.display().to_string());
+    assert!(ok, "{stderr}");
+}
+
+#[test]
+fn a_library_without_fmi3_exports_is_refused_for_an_fmi3_unit() {
+    let dir = scratch("binary_exports_fmi3");
+    let libm = [
+        "/lib/x86_64-linux-gnu/libm.so.6",
+        "/usr/lib/x86_64-linux-gnu/libm.so.6",
+    ]
+    .into_iter()
+    .find(|p| Path::new(p).is_file())
+    .expect("libm.so.6 on this machine");
+    let (ok, stderr, _) = package_as(&dir, libm, "3");
+    assert!(!ok);
+    assert!(
+        stderr.contains("exports none of the 75 FMI 3.0 functions"),
+        "{stderr}"
+    );
+    for arg in ["/dev/zero", "x86_64-linux=/dev/zero"] {
+        let (ok, stderr, _) = package_as(&dir, arg, "3");
+        assert!(!ok && stderr.contains("a character device"), "{stderr}");
+    }
+    let engine = fmu_harness::package::default_binary().expect("the release engine is built");
+    let (ok, stderr, _) = package_as(&dir, &engine.display().to_string(), "3");
     assert!(ok, "{stderr}");
 }

@@ -5,18 +5,21 @@
 
 use super::system::Algorithm;
 use super::{Check, CosimError, Link, Unit};
-use crate::fmi2_binding::{LogMessage, Status};
+use crate::binding::{LogMessage, Status};
 use crate::slave::SlaveError;
 
 /// Why an attempted step is refused (retried with rollback).
 pub(super) enum Refused {
     Discard {
         unit: String,
+        /// fmi2DoStep or fmi3DoStep.
+        function: &'static str,
         messages: Vec<LogMessage>,
     },
     /// fmi2Discard with fmi2Terminated: the unit cannot go on; the run ends at t.
     Ended {
         unit: String,
+        function: &'static str,
         messages: Vec<LogMessage>,
     },
     Check {
@@ -37,13 +40,23 @@ pub(super) enum Refused {
 impl Refused {
     pub(super) fn text(&self) -> String {
         match self {
-            Refused::Discard { unit, messages } | Refused::Ended { unit, messages } => {
+            Refused::Discard {
+                unit,
+                function,
+                messages,
+            }
+            | Refused::Ended {
+                unit,
+                function,
+                messages,
+            } => {
                 let m: Vec<_> = messages.iter().map(|m| m.message.as_str()).collect();
+                let discard = Status::Discard.named_for(function);
                 if m.is_empty() {
-                    format!("unit `{unit}`: fmi2DoStep returned fmi2Discard")
+                    format!("unit `{unit}`: {function} returned {discard}")
                 } else {
                     format!(
-                        "unit `{unit}`: fmi2DoStep returned fmi2Discard: {}",
+                        "unit `{unit}`: {function} returned {discard}: {}",
                         m.join("; ")
                     )
                 }
@@ -122,14 +135,22 @@ pub(super) fn attempt(
             Err(SlaveError::Call {
                 status: Status::Discard,
                 messages,
-                ..
+                function,
             }) => {
                 let unit = u.name.clone();
                 let ended = u.slave.terminated().map_err(|e| u.fail(e))?;
                 return Ok(Some(if ended {
-                    Refused::Ended { unit, messages }
+                    Refused::Ended {
+                        unit,
+                        function,
+                        messages,
+                    }
                 } else {
-                    Refused::Discard { unit, messages }
+                    Refused::Discard {
+                        unit,
+                        function,
+                        messages,
+                    }
                 }));
             }
             Err(e) => return Err(u.fail(e)),

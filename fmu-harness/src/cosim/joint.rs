@@ -140,7 +140,7 @@ impl Joints {
                     let v = md
                         .variable(&name)
                         .map_err(|e| var_err(&format!("{unit_name}.{name}"), e.to_string()))?;
-                    if v.var_type != VarType::Real || v.causality != causality {
+                    if v.var_type != VarType::Real || !v.is_scalar() || v.causality != causality {
                         return Err(var_err(
                             &format!("{unit_name}.{name}"),
                             format!("must be a Real {causality:?} variable"),

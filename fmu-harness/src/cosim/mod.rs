@@ -1,5 +1,7 @@
-//! `fmu-harness cosim system.toml`: several FMI 2.0 co-simulation units (any, not only ours)
-//! coupled output → input, through [`Slave`].
+//! `fmu-harness cosim system.toml`: several FMI 2.0 or 3.0 co-simulation units (any, not only
+//! ours, of either version in one system) coupled output → input, through [`Slave`]. An FMI 3.0
+//! unit has no input derivatives: its inputs are held over a step (as a 2.0 unit's without
+//! canInterpolateInputs).
 //!
 //! One communication step from t to t + h:
 //! 1. with rollback on, every unit's state is saved (fmi2GetFMUstate);
@@ -38,7 +40,7 @@ pub mod system;
 
 pub use results::Summary;
 
-use crate::fmi2_binding::FmuState;
+use crate::binding::FmuState;
 use crate::simulate::{Results, RowSink, MAX_COMMUNICATION_STEPS};
 use crate::slave::{Slave, SlaveError};
 use extrapolation::History;
@@ -238,8 +240,7 @@ pub fn run_into(
     setup::start_values(&mut units, &mut links, t0)?;
     let joints = setup::joints(system, path, &mut units, t0)?;
 
-    let names: Vec<String> = recorded.iter().map(|r| r.2.clone()).collect();
-    let types: Vec<_> = recorded.iter().map(|r| r.1.var_type).collect();
+    let (names, types) = results::columns(&recorded);
     sink.columns(&names, &types).map_err(CosimError::Output)?;
     sink.row(&results::record(&mut units, &recorded, t0)?)
         .map_err(CosimError::Output)?;

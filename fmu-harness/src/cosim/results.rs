@@ -68,6 +68,20 @@ impl Summary {
     }
 }
 
+/// The column names and types of the recorded variables (`(unit, variable, column name)`): an
+/// FMI 3.0 array's elements one column each (`<column name>[1]`, ...).
+pub(super) fn columns(recorded: &[(usize, Variable, String)]) -> (Vec<String>, Vec<VarType>) {
+    let mut names = Vec::new();
+    let mut types = Vec::new();
+    for (_, v, column) in recorded {
+        for c in v.columns() {
+            names.push(format!("{column}{}", &c[v.name.len()..]));
+            types.push(v.var_type);
+        }
+    }
+    (names, types)
+}
+
 /// One row: t, then the recorded variables (`(unit, variable, column name)`) as read now.
 pub(super) fn record(
     units: &mut [Unit],
@@ -78,16 +92,7 @@ pub(super) fn record(
     row.push(t);
     for (i, v, _) in recorded {
         let u = &mut units[*i];
-        let vr = [v.value_reference];
-        let x = match v.var_type {
-            VarType::Real => u.slave.get_real(&vr).map(|x| x[0]),
-            VarType::Integer | VarType::Enumeration => {
-                u.slave.get_integer(&vr).map(|x| x[0] as f64)
-            }
-            VarType::Boolean => u.slave.get_boolean(&vr).map(|x| f64::from(u8::from(x[0]))),
-            VarType::String => Ok(f64::NAN),
-        };
-        row.push(x.map_err(|e| u.fail(e))?);
+        crate::simulate::read_into(&mut u.slave, v, &mut row).map_err(|e| u.fail(e))?;
     }
     Ok(row)
 }

@@ -7,7 +7,7 @@ use super::extrapolation::History;
 use super::joint::Joints;
 use super::system::{self, RollbackSpec, StartValue, System, UnitSpec};
 use super::{Check, CosimError, Link, Unit};
-use crate::fmi2_binding::FmuState;
+use crate::binding::FmuState;
 use crate::slave::{Causality, Slave, SlaveError, VarType, Variable};
 use std::path::Path;
 
@@ -113,6 +113,17 @@ fn set_start_value(
     fail: impl Fn(SlaveError) -> CosimError,
 ) -> Result<(), CosimError> {
     let vr = [v.value_reference];
+    if !v.is_scalar() {
+        return Err(var_err(
+            path,
+            "start value",
+            full,
+            format!(
+                "is an array of {} values: a start value sets a scalar",
+                v.value_count()
+            ),
+        ));
+    }
     let r = match (v.var_type, value) {
         (VarType::Real, StartValue::Real(x)) => slave.set_real(&vr, &[x]),
         (VarType::Real, StartValue::Integer(n)) => slave.set_real(&vr, &[n as f64]),
@@ -133,7 +144,10 @@ fn set_start_value(
                 path,
                 "start value",
                 full,
-                format!("{value:?} does not suit a {ty:?} variable"),
+                format!(
+                    "{value:?} does not suit a {} variable",
+                    ty.name(slave.model_description.fmi_version)
+                ),
             ))
         }
     };
@@ -170,12 +184,13 @@ pub(super) fn links(system: &System, path: &Path, units: &[Unit]) -> Result<Vec<
     for c in &system.connections {
         let (fu, fv) = variable(system, path, units, &c.from, "connection source")?;
         let (tu, tv) = variable(system, path, units, &c.to, "connection target")?;
-        if fv.var_type != VarType::Real || tv.var_type != VarType::Real {
+        let real = |v: &Variable| v.var_type == VarType::Real && v.is_scalar();
+        if !real(&fv) || !real(&tv) {
             return Err(var_err(
                 path,
                 "connection",
                 &format!("{} -> {}", c.from, c.to),
-                "both ends must be Real variables".into(),
+                "both ends must be scalar Real (Float64) variables".into(),
             ));
         }
         if fv.causality != Causality::Output {
@@ -218,12 +233,12 @@ pub(super) fn checks(
     let mut checks = Vec::new();
     for c in rollback.map(|r| r.checks.as_slice()).unwrap_or(&[]) {
         let (u, v) = variable(system, path, units, &c.variable, "rollback check")?;
-        if v.var_type != VarType::Real {
+        if v.var_type != VarType::Real || !v.is_scalar() {
             return Err(var_err(
                 path,
                 "rollback check",
                 &c.variable,
-                "must be a Real variable".into(),
+                "must be a scalar Real (Float64) variable".into(),
             ));
         }
         checks.push(Check {
@@ -238,7 +253,8 @@ pub(super) fn checks(
 }
 
 /// The recorded variables, `(unit, variable, column name)`: the system's `outputs`, or every
-/// output of every unit but the String ones.
+/// output of every unit but those that are no numbers (String, FMI 3.0 types the master does
+/// not move).
 pub(super) fn recorded(
     system: &System,
     path: &Path,
@@ -248,7 +264,7 @@ pub(super) fn recorded(
     if system.outputs.is_empty() {
         for (i, u) in units.iter().enumerate() {
             for v in u.slave.model_description.outputs() {
-                if v.var_type != VarType::String {
+                if v.var_type.is_numeric() {
                     recorded.push((i, v.clone(), format!("{}.{}", u.name, v.name)));
                 }
             }
@@ -256,8 +272,14 @@ pub(super) fn recorded(
     } else {
         for o in &system.outputs {
             let (i, v) = variable(system, path, units, o, "output")?;
-            if v.var_type == VarType::String {
-                return Err(var_err(path, "output", o, "is a String variable".into()));
+            if !v.var_type.is_numeric() {
+                let version = units[i].slave.model_description.fmi_version;
+                return Err(var_err(
+                    path,
+                    "output",
+                    o,
+                    format!("is a {} variable", v.var_type.name(version)),
+                ));
             }
             recorded.push((i, v, o.clone()));
         }

@@ -9,6 +9,7 @@
 //! without blocking before it is opened ([`crate::input_file::open`]: a FIFO would block).
 
 use super::{FmuRefused, SlaveError};
+use crate::platform::{FmiVersion, Platform};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -224,16 +225,26 @@ pub(super) fn binary_inside(dir: &Path, library: &Path) -> Result<(), SlaveError
     Ok(())
 }
 
-/// The co-simulation entry points a binary must export for the master to load it; the other
-/// functions it calls are looked up after loading ([`crate::fmi2_binding::Api::load`]).
-const ENTRY_POINTS: [&str; 3] = ["fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance"];
+/// The co-simulation entry points a binary of `version` must export for the master to load it;
+/// the other functions it calls are looked up after loading ([`crate::fmi2_binding::Api::load`],
+/// [`crate::fmi3_binding::Api::load`]).
+fn entry_points(version: FmiVersion) -> [&'static str; 3] {
+    match version {
+        FmiVersion::V2 => ["fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance"],
+        FmiVersion::V3 => [
+            "fmi3InstantiateCoSimulation",
+            "fmi3DoStep",
+            "fmi3FreeInstance",
+        ],
+    }
+}
 
 /// The model's binary, read before it is loaded: at most
 /// [`crate::engine_library::MAX_LIBRARY_BYTES`], a shared library of the platform this master
-/// runs on (`platform`: ELF x86-64 for linux64, PE32+ AMD64 DLL for win64, from its header)
-/// that exports [`ENTRY_POINTS`] (its symbol table, read with the `object` crate). A file of
+/// runs on ([`Platform::HOST`]: ELF x86-64 on Linux, PE32+ AMD64 DLL on Windows, from its
+/// header) that exports the [`entry_points`] of its FMI `version` (its symbol table, read with the `object` crate). A file of
 /// another kind is refused here, not handed to the system's loader.
-pub(super) fn binary_loadable(library: &Path, platform: &str) -> Result<(), SlaveError> {
+pub(super) fn binary_loadable(library: &Path, version: FmiVersion) -> Result<(), SlaveError> {
     let refuse = |reason: &'static str| {
         SlaveError::from(FmuRefused::Binary {
             path: library.to_path_buf(),
@@ -243,17 +254,20 @@ pub(super) fn binary_loadable(library: &Path, platform: &str) -> Result<(), Slav
     let bytes = crate::engine_library::read(library)
         .map_err(|_| refuse("cannot be read or is larger than 256 MiB"))?;
     let kind = crate::platform::Platform::of_library(&bytes);
-    let Some(kind) = kind.filter(|k| k.folder() == platform) else {
+    let Some(kind) = kind.filter(|&k| k == Platform::HOST) else {
         return Err(refuse(
             "is not a 64-bit shared library of this platform (by its header)",
         ));
     };
-    let missing = crate::engine_library::missing_functions(&bytes, kind)
+    let missing = crate::engine_library::missing_functions_of(&bytes, kind, version)
         .map_err(|_| refuse("has a symbol table that cannot be read"))?;
-    if missing.iter().any(|f| ENTRY_POINTS.contains(f)) {
-        return Err(refuse(
-            "does not export fmi2Instantiate, fmi2DoStep and fmi2FreeInstance",
-        ));
+    if missing.iter().any(|f| entry_points(version).contains(f)) {
+        return Err(refuse(match version {
+            FmiVersion::V2 => "does not export fmi2Instantiate, fmi2DoStep and fmi2FreeInstance",
+            FmiVersion::V3 => {
+                "does not export fmi3InstantiateCoSimulation, fmi3DoStep and fmi3FreeInstance"
+            }
+        }));
     }
     Ok(())
 }

@@ -1,29 +1,35 @@
-//! A safe FMI 2.0 co-simulation slave over [`crate::fmi2_binding`]: extracts an `.fmu` into a
-//! directory of its own, reads its `modelDescription.xml`, loads the binary, and turns every
-//! status other than fmi2OK/fmi2Warning into a [`SlaveError`] that carries the function, the
-//! status and what the FMU logged. Reading `modelDescription.xml` is `description.rs`'s.
+//! A safe FMI 2.0 or 3.0 co-simulation slave over [`crate::fmi2_binding`] or
+//! [`crate::fmi3_binding`], chosen by the model description's `fmiVersion`: extracts an `.fmu`
+//! into a directory of its own, reads its `modelDescription.xml`, loads the binary of its
+//! version's platform folder (`binaries/linux64/`, `binaries/x86_64-linux/`, ...), and turns
+//! every status other than OK/Warning into a [`SlaveError`] that carries the function, the
+//! status and what the FMU logged. Reading `modelDescription.xml` is `description.rs`'s; the
+//! calls, each in both versions, are `calls.rs`'s.
 
+mod calls;
 mod description;
 mod extract;
 
 pub use description::{
-    Causality, DefaultExperiment, ModelDescription, VarType, Variable, MAX_MODEL_IDENTIFIER_BYTES,
+    Causality, DefaultExperiment, ModelDescription, VarType, Variable, MAX_ARRAY_ELEMENTS,
+    MAX_MODEL_IDENTIFIER_BYTES,
 };
 pub use extract::{declared_bytes, MAX_ENTRIES, MAX_EXTRACTED_BYTES, MAX_NAME_BYTES};
 
-use crate::fmi2_binding::{self, Api, FmuState, Instance, LogMessage, Refusal, Status};
+use crate::binding::{LoadError, LogMessage, Refusal, Status};
+use crate::fmi3_binding::StepOutcome;
+use crate::platform::{FmiVersion, Platform};
 use crate::scratch::Scratch;
+use crate::{fmi2_binding, fmi3_binding};
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use thiserror::Error;
 
-/// The FMI platform folder of the binary this master loads: the one of the machine it runs on
-/// (the win64 build of the master, in the win64 wheel, loads `binaries/win64/<id>.dll`).
-pub const PLATFORM: &str = if cfg!(windows) { "win64" } else { "linux64" };
-
-/// The file extension of that binary.
-const LIBRARY_EXTENSION: &str = if cfg!(windows) { "dll" } else { "so" };
+/// The FMI 2.0 platform folder of the binary this master loads: the one of the machine it runs
+/// on (the win64 build of the master, in the win64 wheel, loads `binaries/win64/<id>.dll`); an
+/// FMI 3.0 unit's is its platform tuple ([`Platform::folder_in`]: `x86_64-linux`).
+pub const PLATFORM: &str = Platform::HOST.folder();
 
 #[derive(Debug, Error)]
 pub enum SlaveError {
@@ -44,17 +50,31 @@ pub enum SlaveError {
     #[error(transparent)]
     Refused(Box<FmuRefused>),
     #[error(transparent)]
-    Load(#[from] fmi2_binding::LoadError),
-    #[error("{function} returned {status}{}", messages_suffix(.messages))]
+    Load(#[from] LoadError),
+    #[error("{function} returned {}{}", .status.named_for(function), messages_suffix(.messages))]
     Call {
         function: &'static str,
         status: Status,
         messages: Vec<LogMessage>,
     },
-    #[error("fmi2Instantiate returned NULL{}", messages_suffix(.messages))]
-    Instantiate { messages: Vec<LogMessage> },
+    #[error("{function} returned NULL{}", messages_suffix(.messages))]
+    Instantiate {
+        function: &'static str,
+        messages: Vec<LogMessage>,
+    },
     #[error("{function}: the FMU does not export it")]
     NotExported { function: &'static str },
+    /// A call of FMI 2.0 that FMI 3.0 has no function for (input derivatives).
+    #[error("{function}: FMI 3.0 has no such function (its inputs are held over a step)")]
+    NotInFmi3 { function: &'static str },
+    /// fmi3DoStep returned early, which the master did not allow.
+    #[error(
+        "fmi3DoStep from t = {t} returned early at t = {at} (earlyReturn), which the master \
+         did not allow (earlyReturnAllowed = false)"
+    )]
+    EarlyReturn { t: f64, at: f64 },
+    #[error("{function}: no fmi3DoStep has returned its lastSuccessfulTime yet")]
+    NoStepYet { function: &'static str },
     #[error("{function}: the FMU state belongs to another instance, or is empty")]
     ForeignState { function: &'static str },
     #[error("{function}: the instance was not instantiated (call Slave::instantiate)")]
@@ -96,9 +116,7 @@ pub enum FmuRefused {
         reason: &'static str,
     },
     #[error(
-        "{}: valueReference {vr} of {kind} variable `{second}` is also `{first}`'s; aliases \
-         may share one only if at most one of them is an input or a parameter, and an input \
-         has none",
+        "{}: valueReference {vr} of {kind} variable `{second}` is also `{first}`'s; {rule}",
         .path.display()
     )]
     DuplicateValueReference {
@@ -107,6 +125,8 @@ pub enum FmuRefused {
         kind: &'static str,
         first: String,
         second: String,
+        /// What the FMU's version allows.
+        rule: &'static str,
     },
     #[error("{}: entry `{entry}` {reason}: the master refuses the FMU", .path.display())]
     UnsafeEntry {
@@ -196,19 +216,37 @@ fn uri_of_path(path: &[u8], windows: bool) -> String {
     uri
 }
 
+/// The library of the FMU's version.
+enum Api {
+    V2(Arc<fmi2_binding::Api>),
+    V3(Arc<fmi3_binding::Api>),
+}
+
+/// An instance of the FMU's version.
+enum Live {
+    V2(fmi2_binding::Instance),
+    V3(fmi3_binding::Instance),
+}
+
 /// One FMU: its extracted directory, model description, loaded binary and (after
 /// [`Slave::instantiate`]) one instance.
 pub struct Slave {
     pub model_description: ModelDescription,
-    instance: Option<Instance>,
-    api: Arc<Api>,
+    instance: Option<Live>,
+    api: Api,
     dir: Scratch,
     /// Bytes its extraction wrote.
     extracted: u64,
+    /// FMI 3.0: the experiment that [`Slave::setup_experiment`] was given (tolerance, start,
+    /// stop), passed on by fmi3EnterInitializationMode.
+    experiment: (Option<f64>, f64, Option<f64>),
+    /// FMI 3.0: what the last fmi3DoStep returned besides its status.
+    last_step: Option<StepOutcome>,
 }
 
 impl Slave {
-    /// Extracts the FMU, reads its model description and loads `binaries/linux64/<id>.so`.
+    /// Extracts the FMU, reads its model description and loads the binary of its version
+    /// (`binaries/linux64/<id>.so`, `binaries/x86_64-linux/<id>.so`).
     pub fn load(fmu: &Path) -> Result<Slave, SlaveError> {
         Slave::load_within(fmu, MAX_EXTRACTED_BYTES)
     }
@@ -238,6 +276,8 @@ impl Slave {
             api,
             dir,
             extracted,
+            experiment: (None, 0.0, None),
+            last_step: None,
         })
     }
 
@@ -250,7 +290,7 @@ impl Slave {
         fmu: &Path,
         dir: &Path,
         budget: u64,
-    ) -> Result<(ModelDescription, Arc<Api>, u64), SlaveError> {
+    ) -> Result<(ModelDescription, Api, u64), SlaveError> {
         let extracted = extract::extract(fmu, dir, budget)?;
         let md_path = dir.join("modelDescription.xml");
         let xml = std::fs::read_to_string(&md_path).map_err(|source| SlaveError::Io {
@@ -259,13 +299,21 @@ impl Slave {
             source,
         })?;
         let md = ModelDescription::parse(&xml, &fmu.join("modelDescription.xml"))?;
+        let version = md.fmi_version;
         let so = dir
             .join("binaries")
-            .join(PLATFORM)
-            .join(format!("{}.{LIBRARY_EXTENSION}", md.model_identifier));
+            .join(Platform::HOST.folder_in(version))
+            .join(format!(
+                "{}.{}",
+                md.model_identifier,
+                Platform::HOST.extension()
+            ));
         extract::binary_inside(dir, &so)?;
-        extract::binary_loadable(&so, PLATFORM)?;
-        let api = Api::load(&so)?;
+        extract::binary_loadable(&so, version)?;
+        let api = match version {
+            FmiVersion::V2 => Api::V2(fmi2_binding::Api::load(&so)?),
+            FmiVersion::V3 => Api::V3(fmi3_binding::Api::load(&so)?),
+        };
         Ok((md, api, extracted))
     }
 
@@ -274,33 +322,52 @@ impl Slave {
         self.dir.path()
     }
 
-    /// `fmi2Instantiate` as co-simulation, resources at the extracted `resources/`; replaces
-    /// (frees) a previous instance.
+    /// Instantiates as co-simulation, resources at the extracted `resources/` (FMI 2.0: as a
+    /// `file://` URI; FMI 3.0: as a path with a trailing separator); replaces (frees) a previous
+    /// instance.
     pub fn instantiate(&mut self, name: &str, logging_on: bool) -> Result<(), SlaveError> {
         self.instance = None;
+        self.last_step = None;
         let name = CString::new(name).map_err(|_| SlaveError::Nul {
             what: "the instance name",
         })?;
-        let guid = CString::new(self.model_description.guid.as_str())
-            .map_err(|_| SlaveError::Nul { what: "the GUID" })?;
-        let uri = CString::new(file_uri(&self.dir.path().join("resources"))).map_err(|_| {
-            SlaveError::Nul {
-                what: "the resource URI",
+        let guid =
+            CString::new(self.model_description.guid.as_str()).map_err(|_| SlaveError::Nul {
+                what: "the GUID or instantiationToken",
+            })?;
+        let resources = self.dir.path().join("resources");
+        let nul = |_| SlaveError::Nul {
+            what: "the resource location",
+        };
+        self.instance = Some(match &self.api {
+            Api::V2(api) => {
+                let uri = CString::new(file_uri(&resources)).map_err(nul)?;
+                let i =
+                    fmi2_binding::Instance::instantiate(api, &name, &guid, &uri, false, logging_on)
+                        .map_err(|messages| SlaveError::Instantiate {
+                            function: "fmi2Instantiate",
+                            messages,
+                        })?;
+                Live::V2(i)
             }
-        })?;
-        let instance = Instance::instantiate(&self.api, &name, &guid, &uri, false, logging_on)
-            .map_err(|messages| SlaveError::Instantiate { messages })?;
-        self.instance = Some(instance);
+            Api::V3(api) => {
+                let mut path = resources.into_os_string();
+                path.push(std::path::MAIN_SEPARATOR_STR);
+                let path = CString::new(path.as_encoded_bytes().to_vec()).map_err(nul)?;
+                let i = fmi3_binding::Instance::instantiate(
+                    api, &name, &guid, &path, false, logging_on,
+                )
+                .map_err(|messages| SlaveError::Instantiate {
+                    function: "fmi3InstantiateCoSimulation",
+                    messages,
+                })?;
+                Live::V3(i)
+            }
+        });
         Ok(())
     }
 
-    fn live(&mut self, function: &'static str) -> Result<&mut Instance, SlaveError> {
-        self.instance
-            .as_mut()
-            .ok_or(SlaveError::NotInstantiated { function })
-    }
-
-    /// Ok for fmi2OK and fmi2Warning; anything else an error with the logged messages.
+    /// Ok for OK and Warning; anything else an error with the logged messages.
     fn check(&mut self, function: &'static str, status: Status) -> Result<Status, SlaveError> {
         if status.is_success() {
             Ok(status)
@@ -323,188 +390,17 @@ impl Slave {
 
     /// The messages the FMU logged since the last take (errors take them too).
     pub fn take_messages(&mut self) -> Vec<LogMessage> {
-        self.instance
-            .as_ref()
-            .map(Instance::take_messages)
-            .unwrap_or_default()
-    }
-
-    pub fn setup_experiment(
-        &mut self,
-        tolerance: Option<f64>,
-        start_time: f64,
-        stop_time: Option<f64>,
-    ) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetupExperiment";
-        let s = self
-            .live(F)?
-            .setup_experiment(tolerance, start_time, stop_time);
-        self.check(F, s)
-    }
-
-    pub fn enter_initialization_mode(&mut self) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2EnterInitializationMode";
-        let s = self.live(F)?.enter_initialization_mode();
-        self.check(F, s)
-    }
-
-    pub fn exit_initialization_mode(&mut self) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2ExitInitializationMode";
-        let s = self.live(F)?.exit_initialization_mode();
-        self.check(F, s)
-    }
-
-    pub fn do_step(&mut self, t: f64, h: f64, no_set_prior: bool) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2DoStep";
-        let s = self.live(F)?.do_step(t, h, no_set_prior);
-        self.check(F, s)
-    }
-
-    /// fmi2GetBooleanStatus(fmi2Terminated): whether the FMU asks to end the simulation (after
-    /// a Discard). False when the FMU does not export the function or does not answer it
-    /// (fmi2Error, as an FMU that never ends a simulation may); what it logged then is dropped.
-    pub fn terminated(&mut self) -> Result<bool, SlaveError> {
-        const F: &str = "fmi2GetBooleanStatus";
-        match self
-            .live(F)?
-            .get_boolean_status(fmi2_binding::fmi2Terminated)
-        {
-            Ok((s, value)) if s.is_success() => Ok(value),
-            Ok(_) | Err(Refusal::NotExported(_)) => {
-                let _ = self.take_messages();
-                Ok(false)
-            }
-            Err(r) => Err(Self::refused(F, r)),
+        match &self.instance {
+            Some(Live::V2(i)) => i.take_messages(),
+            Some(Live::V3(i)) => i.take_messages(),
+            None => Vec::new(),
         }
-    }
-
-    /// fmi2GetRealStatus(fmi2LastSuccessfulTime): the time of the FMU's last good state.
-    pub fn last_successful_time(&mut self) -> Result<f64, SlaveError> {
-        const F: &str = "fmi2GetRealStatus";
-        match self
-            .live(F)?
-            .get_real_status(fmi2_binding::fmi2LastSuccessfulTime)
-        {
-            Ok((s, value)) => self.check(F, s).map(|_| value),
-            Err(r) => Err(Self::refused(F, r)),
-        }
-    }
-
-    pub fn terminate(&mut self) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2Terminate";
-        let s = self.live(F)?.terminate();
-        self.check(F, s)
-    }
-
-    pub fn reset(&mut self) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2Reset";
-        let s = self.live(F)?.reset();
-        self.check(F, s)
-    }
-
-    pub fn get_real(&mut self, vr: &[u32]) -> Result<Vec<f64>, SlaveError> {
-        const F: &str = "fmi2GetReal";
-        let mut values = vec![0.0; vr.len()];
-        let s = self.live(F)?.get_real(vr, &mut values);
-        self.check(F, s).map(|_| values)
-    }
-
-    pub fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetReal";
-        let s = self.live(F)?.set_real(vr, values);
-        self.check(F, s)
-    }
-
-    pub fn get_integer(&mut self, vr: &[u32]) -> Result<Vec<i32>, SlaveError> {
-        const F: &str = "fmi2GetInteger";
-        let mut values = vec![0; vr.len()];
-        let s = self.live(F)?.get_integer(vr, &mut values);
-        self.check(F, s).map(|_| values)
-    }
-
-    pub fn set_integer(&mut self, vr: &[u32], values: &[i32]) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetInteger";
-        let s = self.live(F)?.set_integer(vr, values);
-        self.check(F, s)
-    }
-
-    pub fn get_boolean(&mut self, vr: &[u32]) -> Result<Vec<bool>, SlaveError> {
-        const F: &str = "fmi2GetBoolean";
-        let mut values = vec![0; vr.len()];
-        let s = self.live(F)?.get_boolean(vr, &mut values);
-        self.check(F, s)
-            .map(|_| values.iter().map(|&b| b != 0).collect())
-    }
-
-    pub fn set_boolean(&mut self, vr: &[u32], values: &[bool]) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetBoolean";
-        let ints: Vec<i32> = values.iter().map(|&b| b as i32).collect();
-        let s = self.live(F)?.set_boolean(vr, &ints);
-        self.check(F, s)
-    }
-
-    pub fn set_real_input_derivatives(
-        &mut self,
-        vr: &[u32],
-        order: &[i32],
-        values: &[f64],
-    ) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetRealInputDerivatives";
-        let s = self
-            .live(F)?
-            .set_real_input_derivatives(vr, order, values)
-            .map_err(|r| Self::refused(F, r))?;
-        self.check(F, s)
-    }
-
-    /// `fmi2GetDirectionalDerivative`: Σ_j ∂unknown_i/∂known_j dv_j for each unknown.
-    pub fn get_directional_derivative(
-        &mut self,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-    ) -> Result<Vec<f64>, SlaveError> {
-        const F: &str = "fmi2GetDirectionalDerivative";
-        let mut out = vec![0.0; unknowns.len()];
-        let s = self
-            .live(F)?
-            .get_directional_derivative(unknowns, knowns, dv_known, &mut out)
-            .map_err(|r| Self::refused(F, r))?;
-        self.check(F, s).map(|_| out)
-    }
-
-    /// `fmi2GetFMUstate` into an empty state or one this instance made before.
-    pub fn get_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2GetFMUstate";
-        let s = self
-            .live(F)?
-            .get_fmu_state(state)
-            .map_err(|r| Self::refused(F, r))?;
-        self.check(F, s)
-    }
-
-    pub fn set_fmu_state(&mut self, state: &FmuState) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2SetFMUstate";
-        let s = self
-            .live(F)?
-            .set_fmu_state(state)
-            .map_err(|r| Self::refused(F, r))?;
-        self.check(F, s)
-    }
-
-    pub fn free_fmu_state(&mut self, state: &mut FmuState) -> Result<Status, SlaveError> {
-        const F: &str = "fmi2FreeFMUstate";
-        let s = self
-            .live(F)?
-            .free_fmu_state(state)
-            .map_err(|r| Self::refused(F, r))?;
-        self.check(F, s)
     }
 }
 
 impl Drop for Slave {
     fn drop(&mut self) {
-        // fmi2FreeInstance first, while the library is loaded; the files go last.
+        // The instance is freed first, while the library is loaded; the files go last.
         self.instance = None;
     }
 }

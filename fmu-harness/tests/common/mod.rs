@@ -2,6 +2,8 @@
 //! running the built `fmu-harness` binary.
 #![allow(dead_code)]
 
+pub mod hostile;
+
 use fmu_harness::platform::{library_header, Platform};
 use std::path::{Path, PathBuf};
 use std::process::Output;
