@@ -10,11 +10,14 @@ Exudyn's cheapest run in build/bench/peer_points.csv (`sweep.py`) whose error ON
 (the FMU's) is at most ours, re-run here (`cheapest_peer`). Ours and Exudyn's runs alternate (ours, Exudyn's, ours, ...) so that both see the
 same load on a shared machine.
 
-Our time is the process CPU time of the whole call a user makes, in two forms:
+Our time is the process CPU time of the whole call a user makes, in two forms, and of the run:
   * `fmu`: simulate_fmu(path): unzips the FMU, reads modelDescription.xml, loads the engine,
     instantiates (reads the scene, builds the system) and runs: what one call costs;
   * `extracted`: simulate_fmu(directory) on an FMU extracted once (fmpy.extract), as a script
-    that runs a unit more than once does.
+    that runs a unit more than once does;
+  * `run`: fmi2Instantiate to fmi2FreeInstance on the extracted, loaded unit, stepped over its
+    DefaultExperiment's grid with every output read (`instantiate_to_terminate`): what issue
+    46's independent run timed.
 Exudyn's time is the CPU time of its SolveSystem alone (model building excluded, as in the
 sweep). The ratio is ours / Exudyn's, median of the per-pair ratios, with min and max.
 
@@ -127,26 +130,58 @@ def cheapest_peer(points, case, column, error, t=None, ref=None):
     return dict(min(runs, key=lambda p: float(p['error'])), best=True)
 
 
-def row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir, theirs):
+def row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir, ours_run, theirs):
     row = dict(scene=scene, case=case, output=column, comm_step=comm, error=error,
                ours_fmu=statistics.median(ours_fmu), ours_extracted=statistics.median(ours_dir),
+               ours_run=statistics.median(ours_run),
                peer_setting=(peer['setting'] + (' (its most accurate: ratio an upper bound)'
                                                  if peer['best'] else '')
                              + (' (scored on our grid)' if peer.get('rescored') else '')
                              if peer else 'no run in the sweep'),
                peer_error=float(peer['error']) if peer else float('nan'),
                peer_cpu=statistics.median(theirs) if theirs else float('nan'))
-    for key, ours in (('fmu', ours_fmu), ('extracted', ours_dir)):
+    for key, ours in (('fmu', ours_fmu), ('extracted', ours_dir), ('run', ours_run)):
         ratios = [o / t for o, t in zip(ours, theirs)] if theirs else [float('nan')]
         row['ratio_' + key] = statistics.median(ratios)
         row['ratio_%s_min' % key] = min(ratios)
         row['ratio_%s_max' % key] = max(ratios)
     print('%-32s %-18s error %.2e  ours %.4f s (extracted %.4f s)  Exudyn %s %.2e %.4f s  '
-          'ratio %.2f (extracted %.2f)' % (
+          'ratio %.2f (extracted %.2f, instantiate to terminate %.2f)' % (
               scene, column, error, row['ours_fmu'], row['ours_extracted'], row['peer_setting'],
-              row['peer_error'], row['peer_cpu'], row['ratio_fmu'], row['ratio_extracted']),
+              row['peer_error'], row['peer_cpu'], row['ratio_fmu'], row['ratio_extracted'],
+              row['ratio_run']),
           flush=True)
     return row
+
+
+def instantiate_to_terminate(unzipdir, fmpy):
+    """CPU seconds from fmi2Instantiate to fmi2FreeInstance of a unit already extracted and
+    loaded, stepped over its DefaultExperiment's grid and read at every point: what issue 46's
+    independent run timed, the part of a call that compares with the peer's SolveSystem (model
+    building excluded on its side, our scene's build included on ours)."""
+    from fmpy.fmi2 import FMU2Slave
+    md = fmpy.read_model_description(unzipdir)
+    de = md.defaultExperiment
+    vrs = [v.valueReference for v in md.modelVariables
+           if v.causality == 'output' and v.type == 'Real']
+    unit = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
+                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName='timed')
+    n = int(round((float(de.stopTime) - float(de.startTime or 0)) / float(de.stepSize)))
+    h = float(de.stepSize)
+    t0 = time.process_time()
+    unit.instantiate()
+    unit.setupExperiment(startTime=0.0)
+    unit.enterInitializationMode()
+    unit.exitInitializationMode()
+    unit.getReal(vrs)
+    for k in range(n):
+        unit.doStep(k * h, h)
+        unit.getReal(vrs)
+    unit.terminate()
+    unit.freeInstance()
+    seconds = time.process_time() - t0
+    unit.freeLibrary()
+    return seconds
 
 
 def cpu(fn):
@@ -182,14 +217,15 @@ def main():
                 t_ours = np.asarray(result['time'], dtype=float)
                 peer = cheapest_peer(points, case, column, error, t_ours, ref)
                 peer_args = parse_setting(peer['setting']) if peer else None
-                ours_fmu, ours_dir, theirs = [], [], []
+                ours_fmu, ours_dir, ours_run, theirs = [], [], [], []
                 for _ in range(args.repeats):
                     ours_fmu.append(cpu(lambda: fmpy.simulate_fmu(fmu))[0])
                     ours_dir.append(cpu(lambda: fmpy.simulate_fmu(unzipdir))[0])
+                    ours_run.append(instantiate_to_terminate(unzipdir, fmpy))
                     if peer_args:
                         theirs.append(ec.run(case, **peer_args).cpu)
                 rows.append(row_of(scene, case, column, comm, error, peer, ours_fmu, ours_dir,
-                                   theirs))
+                                   ours_run, theirs))
         finally:
             shutil.rmtree(unzipdir, ignore_errors=True)
     os.makedirs(OUT_DIR, exist_ok=True)
@@ -209,22 +245,25 @@ def main():
         'most accurate run); %d interleaved runs each, ratio ='
         % args.repeats,
         'ours / Exudyn\'s CPU time, median (min-max) of the pairs. `one call`: simulate_fmu on the',
-        '.fmu (unzip, load, instantiate, run); `extracted`: on the FMU extracted once.',
+        '.fmu (unzip, load, instantiate, run); `extracted`: on the FMU extracted once; `run`:',
+        'fmi2Instantiate to fmi2FreeInstance on the DefaultExperiment\'s grid, every output read',
+        '(what issue 46 timed; Exudyn\'s time is its SolveSystem, model building excluded).',
         'Load average at the end: %.1f %.1f %.1f; %.0f s wall.' % (load + (time.time() - wall0,)),
         '',
-        '| scene | output | comm. step (s) | error | ours, one call (s) | extracted (s) | '
+        '| scene | output | comm. step (s) | error | ours, one call (s) | extracted (s) | run (s) | '
         'Exudyn\'s cheapest as accurate | its error | its CPU (s) | ratio, one call | '
-        'ratio, extracted |',
-        '|---|---|---|---|---|---|---|---|---|---|---|',
+        'ratio, extracted | ratio, run |',
+        '|---|---|---|---|---|---|---|---|---|---|---|---|---|',
     ]
     for r in rows:
-        lines.append('| %s | %s | %g | %.2e | %.4f | %.4f | %s | %.2e | %.4f | %.2f (%.2f-%.2f) | '
-                     '%.2f (%.2f-%.2f) |' % (
+        lines.append('| %s | %s | %g | %.2e | %.4f | %.4f | %.4f | %s | %.2e | %.4f | '
+                     '%.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) |' % (
                          r['scene'], r['output'], r['comm_step'], r['error'], r['ours_fmu'],
-                         r['ours_extracted'], r['peer_setting'], r['peer_error'], r['peer_cpu'],
-                         r['ratio_fmu'], r['ratio_fmu_min'], r['ratio_fmu_max'],
+                         r['ours_extracted'], r['ours_run'], r['peer_setting'], r['peer_error'],
+                         r['peer_cpu'], r['ratio_fmu'], r['ratio_fmu_min'], r['ratio_fmu_max'],
                          r['ratio_extracted'], r['ratio_extracted_min'],
-                         r['ratio_extracted_max']))
+                         r['ratio_extracted_max'], r['ratio_run'], r['ratio_run_min'],
+                         r['ratio_run_max']))
     text = '\n'.join(lines) + '\n'
     with open(os.path.join(OUT_DIR, 'AS_SHIPPED.md'), 'w') as f:
         f.write(text)
