@@ -33,18 +33,21 @@ LONG_RUN = 20.0      # s: runs longer than this are timed once
 TARGETS = (1e-2, 1e-3, 1e-4, 1e-5)
 FORMULATION = 'ANCF2D cable, generalized-alpha index 3'
 
-# (n_elements list, step list, spectral radius list) per case. Steps divide the output spacing:
-# Exudyn writes outputs at step points only (no dense output).
+# (n_elements list, step list, spectral radius list) per case. Steps divide the output spacing
+# or are multiples of it (then scored at the step points only): Exudyn writes outputs at step
+# points only (no dense output). The steps above 1e-3 s on C2 and C3 (since 2026-12-06): at the
+# loose targets the peer's cheapest setting is a coarse step, as ours is (C4 at 2e-2 s with 8
+# elements, and Ω = 4 at 5e-2 s with 4, diverged: its steps stop at the 1e-2 s grid).
 GRID = {
     # the tip deflection's 1e-3 is decided below 5e-5 s (the phase of its 260-430 Hz modes),
     # as our steps go to 1e-5 s
-    'c2': [((2, 4, 8, 16, 32), (1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5), (0.9,)),
+    'c2': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5), (0.9,)),
            ((16, 32), (2.5e-5, 1e-5), (0.9,)),
            ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
-    'c3_elastic': [((2, 4, 8, 16, 32), (1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
+    'c3_elastic': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
                    ((4, 8, 16), (5e-5, 2.5e-5), (0.9,)),
                    ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
-    'c3_rigid': [((2, 4, 8, 16, 32), (1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
+    'c3_rigid': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
                  ((4, 8, 16), (5e-5, 2.5e-5), (0.9,))],
     'c4_omega10': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                    ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
@@ -110,9 +113,12 @@ def main(quick=False):
                             if res.outputs is None:
                                 err = float('nan')
                             else:
-                                y, yr = res.outputs[out], ref[out]
-                                assert len(y) == len(yr) and np.allclose(res.t, ref['t'])
-                                err = float(np.max(np.abs(y - yr)) / np.max(np.abs(yr)))
+                                # the reference on the run's grid: the case's, or the step
+                                # points of a step coarser than it (a subset of it)
+                                y = res.outputs[out]
+                                yr = np.interp(res.t, ref['t'], ref[out])
+                                assert len(y) == len(yr)
+                                err = float(np.max(np.abs(y - yr)) / np.max(np.abs(ref[out])))
                             rows.append(dict(case=case, output=out, tool='exudyn',
                                              formulation=FORMULATION, setting=name,
                                              error=err, cpu_median=statistics.median(cpus),
