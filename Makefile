@@ -129,10 +129,15 @@ fmus: release win64
 WHEEL_ENGINES := python/fmu_beam/engines
 WHEEL_TARGET  := x86_64-unknown-linux-gnu
 WHEEL_DIR     := target/wheel
-MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" CARGO_TARGET_DIR=$(WHEEL_DIR) nice \
-  $(VENV)/bin/maturin build --release --zig --compatibility manylinux_2_28
+# Every maturin pass holds build/wheel/maturin.lock: cargo's own lock serializes the compiles, but
+# maturin then stages the library at one fixed path of $(WHEEL_DIR), and two passes at once (the
+# background first pass still running when `wheel` starts) race on it ("failed to stage ...").
+MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" CARGO_TARGET_DIR=$(WHEEL_DIR) \
+  flock build/wheel/maturin.lock nice $(VENV)/bin/maturin build --release --zig \
+  --compatibility manylinux_2_28
 wheel: .venv
 	rm -rf $(WHEEL_ENGINES) build/wheel/first dist/fmu_beam-*.whl
+	mkdir -p build/wheel
 	$(MATURIN) --out build/wheel/first
 	rm -rf build/wheel/prebuild
 	$(MAKE) --no-print-directory win64
@@ -195,7 +200,7 @@ demo: .venv fmus
 # item 6): the Windows engine (log: build/win64/build.log) and the wheel's first pass (log:
 # build/wheel/prebuild.log; its own $(WHEEL_DIR), so no cargo lock is shared with the Linux
 # build) compile niced in the background from the start, while the Linux build and the Rust
-# tests run in front; `wheel` then waits for both (cargo's locks) and finds them built.
+# tests run in front; `wheel` then waits for both (maturin.lock, cargo's lock) and finds them built.
 # The Rust tests run under cargo-nextest where it is installed (every test binary side by side;
 # `cargo test` runs them one after the other and the long single tests leave a core idle).
 # pytest runs in three processes: tests/test_no_leaks.py (1e4 cycles under valgrind, 2 min on
