@@ -26,9 +26,17 @@ const REFERENCES: [(&str, &str, &str); 8] = [
     ("flexible_pendulum", "c2.csv", "tip_y"),
     ("flexible_pendulum_substructured", "c2.csv", "tip_y"),
     ("slider_crank", "c3_elastic.csv", "slider_position"),
-    ("slider_crank_rigid_crank", "c3_rigid.csv", "slider_position"),
+    (
+        "slider_crank_rigid_crank",
+        "c3_rigid.csv",
+        "slider_position",
+    ),
     ("spin_up_omega10", "c4_omega10.csv", "tip_deflection"),
-    ("spin_up_omega10_stiffened", "c4_omega10.csv", "tip_deflection"),
+    (
+        "spin_up_omega10_stiffened",
+        "c4_omega10.csv",
+        "tip_deflection",
+    ),
     ("spin_up_omega4", "c4_omega4.csv", "tip_deflection"),
     ("spin_up_omega4_auto", "c4_omega4.csv", "tip_deflection"),
 ];
@@ -116,7 +124,9 @@ fn observed_error(name: &str) -> f64 {
 /// Whether an observed error bears out a statement of `target` and `estimate`.
 fn judge(observed: f64, target: f64, estimate: f64) -> Result<(), String> {
     if observed > target {
-        return Err(format!("error {observed:.2e} above the target {target:.0e}"));
+        return Err(format!(
+            "error {observed:.2e} above the target {target:.0e}"
+        ));
     }
     if observed > OVER * estimate {
         return Err(format!(

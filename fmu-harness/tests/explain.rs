@@ -48,6 +48,36 @@ fn explain_prints_every_effect_with_its_reason() {
     assert!(rows.iter().all(|l| l.contains('%')), "{text}");
 }
 
+/// Every shipped scene with an `[accuracy]` table (issue 46 item 2: 17 of them) is stated
+/// first by `explain`: its output, its target and the study's estimate.
+#[test]
+fn explain_states_every_shipped_scene_s_accuracy_first() {
+    let dir = c1_path().parent().expect("scenes/").to_path_buf();
+    let mut stated = 0;
+    for entry in std::fs::read_dir(&dir).expect("scenes/") {
+        let path = entry.expect("an entry").path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let scene = fmu_beam::Scene::load(&path).expect("a valid scene");
+        let Some(acc) = scene.accuracy else { continue };
+        let r = harness(&["explain".as_ref(), path.as_os_str()]);
+        let text = String::from_utf8_lossy(&r.stdout);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let first = text.lines().next().unwrap_or_default();
+        let estimate = format!("{:.1e}", acc.estimate.expect("an estimate"));
+        assert!(
+            first.starts_with("Accuracy:")
+                && first.contains(&acc.output)
+                && first.contains(&format!("at most {:e}", acc.target))
+                && first.contains(&estimate),
+            "{path:?}: {first}"
+        );
+        stated += 1;
+    }
+    assert_eq!(stated, 17, "the shipped scenes with an [accuracy] table");
+}
+
 #[test]
 fn a_wrong_effects_entry_is_refused_naming_the_field() {
     let dir = scratch("explain_refused");
@@ -66,14 +96,20 @@ fn a_wrong_effects_entry_is_refused_naming_the_field() {
     );
 }
 
-/// The scene with an `[accuracy]` statement for `output` appended.
+/// C1 with its own `[accuracy]` statement for `output` replaced by one for `output`.
 fn with_accuracy(dir: &std::path::Path, output: &str) -> std::path::PathBuf {
     let scene = dir.join("tuned.toml");
+    let text = c1_text();
+    let (head, rest) = text
+        .split_once("[accuracy]\n")
+        .expect("C1 states its accuracy");
+    let (_, tail) = rest
+        .split_once("\n\n")
+        .expect("a blank line after the table");
     std::fs::write(
         &scene,
         format!(
-            "{}\n[accuracy]\noutput = \"{output}\"\ntarget = 1e-3\nestimate = 4e-4\n",
-            c1_text()
+            "{head}{tail}\n[accuracy]\noutput = \"{output}\"\ntarget = 1e-3\nestimate = 4e-4\n"
         ),
     )
     .unwrap();
