@@ -23,6 +23,9 @@ REFERENCES = {
     "slider_crank_rigid_crank": ("c3_rigid", {"slider.position": "slider_position"}),
     "spin_up_omega10": ("c4_omega10", {"beam.tip.deflection": "tip_deflection"}),
     "spin_up_omega4": ("c4_omega4", {"beam.tip.deflection": "tip_deflection"}),
+    # the C4 variants (issue 46 item 2): effects = "auto" on 5 x 1, one stiffened frame
+    "spin_up_omega4_auto": ("c4_omega4", {"beam.tip.deflection": "tip_deflection"}),
+    "spin_up_omega10_stiffened": ("c4_omega10", {"beam.tip.deflection": "tip_deflection"}),
 }
 
 
