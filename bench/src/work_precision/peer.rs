@@ -63,7 +63,10 @@ fn formulation(name: &'static str, edits: &[Edit]) -> Formulation {
 
 /// The cases, with the formulations and settings swept.
 pub fn cases() -> Vec<PeerCase> {
+    // from 1e-2 s, as the peer's coarsest step (bench/peer/sweep.py): at the loose targets the
+    // cheapest setting of either tool is a coarse step on a coarse mesh
     let c3_settings = vec![
+        H(1e-2),
         H(4e-3),
         H(2e-3),
         H(1e-3),
@@ -117,8 +120,14 @@ pub fn cases() -> Vec<PeerCase> {
                     &[Elements("beam", 4), Pinned("beam")],
                 ),
                 formulation("3 x 2 substructures", &[Substructures("beam", 3, 2)]),
+                // the peer's cheapest at 1e-2 and 1e-3 is 2 elements
+                formulation(
+                    "single frame, 2 elements",
+                    &[Elements("beam", 2), Pinned("beam")],
+                ),
             ],
             settings: vec![
+                H(1e-2),
                 H(5e-3),
                 H(2e-3),
                 H(1e-3),
@@ -165,6 +174,11 @@ pub fn cases() -> Vec<PeerCase> {
                     "crank 6, rod 16",
                     &[Elements("crank", 6), Elements("rod", 16)],
                 ),
+                // the peer's cheapest at 1e-2 to 1e-4 is crank 1, rod 2
+                formulation(
+                    "crank 1, rod 2",
+                    &[Elements("crank", 1), Elements("rod", 2)],
+                ),
             ],
             settings: c3_settings.clone(),
             least_budget: 0.0,
@@ -183,6 +197,7 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("rod 4", &[Elements("rod", 4)]),
                 formulation("rod 8", &[Elements("rod", 8)]),
                 formulation("rod 16", &[Elements("rod", 16)]),
+                formulation("rod 2", &[Elements("rod", 2)]),
             ],
             settings: c3_settings,
             least_budget: 0.0,
