@@ -155,18 +155,21 @@ pub fn compare(
     let run_theirs = || peer::simulate(&theirs, case);
     let mut a = Timing::start(&run_mine).map_err(engine)?;
     let mut b = Timing::start(&run_theirs).map_err(engine)?;
-    let error = |t: &Timing| {
+    // each run on the points it reports (`peer::stride`: a fixed step above the grid, at its
+    // step points)
+    let error = |t: &Timing, scene: &Scene| {
         let y = &t.first.values[k];
-        if y.len() != reference.len() {
+        let stride = peer::stride(scene, case);
+        if y.len() != reference.len().div_ceil(stride) {
             return Err(input(format!(
                 "{} values against {} reference rows",
                 y.len(),
                 reference.len()
             )));
         }
-        Ok(super::error(y, &reference).1)
+        Ok(peer::scored(y, &reference, stride))
     };
-    let (ea, eb) = (error(&a)?, error(&b)?);
+    let (ea, eb) = (error(&a, &mine)?, error(&b, &theirs)?);
     a.samples.clear();
     b.samples.clear();
     for round in 0..repeats.max(1) {

@@ -361,8 +361,39 @@ pub(super) fn configure(
     Ok(Scene::from_toml_str(&s.to_toml_string(), &origin)?)
 }
 
-/// Runs `scene` over the case's grid; values per output of the case, and the counters: steps,
-/// Newton iterations, iteration matrices.
+/// How many of the case's grid points one communication step spans: a fixed step that is a
+/// multiple of the grid and divides the run reports at its step points only (1 otherwise), as
+/// the peer's runs at those steps are scored (`bench/peer/sweep.py`); both tools are then
+/// asked the same, and neither pays for points between its steps.
+pub(super) fn stride(scene: &Scene, case: &PeerCase) -> usize {
+    let h = scene.solver.max_step;
+    let k = (h / case.comm).round();
+    let whole = |x: f64| (x - x.round()).abs() < 1e-9 * x.max(1.0);
+    if scene.solver.adaptive || k < 2.0 || (k * case.comm - h).abs() > 1e-9 * h {
+        return 1;
+    }
+    if whole(case.stop / h) {
+        k as usize
+    } else {
+        1
+    }
+}
+
+/// The error of `y` (at every `stride`-th point of the case's grid) against the reference on
+/// that grid, relative to the reference's largest value over the whole grid.
+pub(super) fn scored(y: &[f64], reference: &[f64], stride: usize) -> f64 {
+    let at: Vec<f64> = reference.iter().step_by(stride).copied().collect();
+    let (e, _) = super::error(y, &at);
+    let scale = reference.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+    if scale > 0.0 && y.len() == at.len() {
+        e / scale
+    } else {
+        f64::NAN
+    }
+}
+
+/// Runs `scene` over the case's grid (every [`stride`]-th point); values per output of the
+/// case, and the counters: steps, Newton iterations, iteration matrices.
 pub(super) fn simulate(scene: &Scene, case: &PeerCase) -> Result<Series, EngineError> {
     simulate_engine(scene, case).map(|(series, _)| series)
 }
@@ -393,11 +424,12 @@ pub(super) fn simulate_engine(
             }
         });
     }
-    let n = (case.stop / case.comm).round() as usize;
+    let comm = case.comm * stride(scene, case) as f64;
+    let n = (case.stop / comm).round() as usize;
     let mut values = vec![Vec::with_capacity(n + 1); case.outputs.len()];
     for k in 0..=n {
         if k > 0 {
-            e.do_step((k - 1) as f64 * case.comm, case.comm)?;
+            e.do_step((k - 1) as f64 * comm, comm)?;
         }
         for (o, vrs) in reads.iter().enumerate() {
             let y = match vrs[..] {
@@ -506,7 +538,7 @@ pub fn study(
                         for ((col, _), (y, r)) in
                             case.outputs.iter().zip(s.values.iter().zip(&columns))
                         {
-                            let (_, rel) = super::error(y, r);
+                            let rel = scored(y, r, stride(&scene, case));
                             let _ = write!(line, ", {col} {rel:.2e}");
                             points.push(PeerPoint {
                                 case: case.name.into(),
@@ -924,6 +956,36 @@ mod tests {
             seconds: [cpu; 3],
             steps: 0,
         }
+    }
+
+    #[test]
+    fn a_fixed_step_above_the_grid_reports_at_its_step_points_only() {
+        let base =
+            Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/slider_crank.toml"))
+                .expect("the shipped scene");
+        let case = cases()
+            .into_iter()
+            .find(|c| c.name == "c3_elastic")
+            .expect("c3");
+        let f = &case.formulations[0];
+        let at = |setting| {
+            stride(
+                &configure(&base, f, setting, None).expect("configured"),
+                &case,
+            )
+        };
+        assert_eq!(at(Setting::FixedStep(1e-2)), 10);
+        assert_eq!(at(Setting::FixedStep(4e-3)), 4);
+        assert_eq!(at(Setting::FixedStep(1e-3)), 1);
+        assert_eq!(at(Setting::FixedStep(5e-4)), 1);
+        // not a multiple of the grid, or not dividing the run: the whole grid
+        assert_eq!(at(Setting::FixedStep(1.5e-3)), 1);
+        assert_eq!(at(Setting::FixedStep(7e-3)), 1);
+        assert_eq!(at(Setting::Tolerance(1e-4)), 1);
+        // scored at the points reported, against the largest value of the whole reference
+        let reference = [0.0, 1.0, 4.0, 1.0, 0.0];
+        assert_eq!(scored(&[0.0, 4.5, 0.0], &reference, 2), 0.5 / 4.0);
+        assert!(scored(&[0.0, 4.5], &reference, 2).is_nan());
     }
 
     #[test]

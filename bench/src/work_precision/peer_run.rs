@@ -196,7 +196,7 @@ pub fn run(r: &Request) -> Result<String, BenchError> {
             .position(|c| c == col)
             .ok_or_else(|| bad(format!("{}: no column {col}", case.reference)))?;
         let reference: Vec<f64> = rows[..n].iter().map(|row| row[at]).collect();
-        let (_, rel) = super::error(y, &reference);
+        let rel = peer::scored(y, &reference, peer::stride(&scene, &case));
         let _ = write!(
             json,
             "{}\"{col}\": {rel:.6e}",
