@@ -11,29 +11,8 @@
 //! case here runs both ways, so the test shows what the stiffness buys.
 
 mod common;
-use common::{run, scene};
+use common::{reference, run, scene};
 use fmu_beam::Scene;
-use std::path::Path;
-
-/// Columns of a reference CSV (header line, then numbers).
-fn reference(file: &str) -> (Vec<String>, Vec<Vec<f64>>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../bench/reference")
-        .join(file);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
-    let mut lines = text.lines();
-    let names = lines
-        .next()
-        .expect("a header")
-        .split(',')
-        .map(String::from)
-        .collect();
-    let rows = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect())
-        .collect();
-    (names, rows)
-}
 
 /// max |ours − reference| / max |reference| of column `name` of the reference against the
 /// series `ours` sampled on the same grid.

@@ -43,21 +43,8 @@ const REFERENCES: [(&str, &str, &str); 8] = [
 
 /// A column of a reference CSV and its grid step.
 fn reference(file: &str, column: &str) -> (Vec<f64>, f64) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../bench/reference")
-        .join(file);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
-    let mut lines = text.lines();
-    let k = lines
-        .next()
-        .expect("a header")
-        .split(',')
-        .position(|n| n == column)
-        .expect("the column");
-    let rows: Vec<Vec<f64>> = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect())
-        .collect();
+    let (names, rows) = common::reference(file);
+    let k = names.iter().position(|n| n == column).expect("the column");
     let grid = rows[1][0] - rows[0][0];
     (rows.iter().map(|r| r[k]).collect(), grid)
 }

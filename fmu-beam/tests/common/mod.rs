@@ -68,3 +68,23 @@ pub fn run(scene: Scene, params: &[(&str, f64)], outputs: &[&str], hc: f64, stop
     }
     Run { rows, engine: e }
 }
+
+/// Columns of a reference CSV of `bench/reference/` (header line, then numbers).
+pub fn reference(file: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../bench/reference")
+        .join(file);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+    let mut lines = text.lines();
+    let names = lines
+        .next()
+        .expect("a header")
+        .split(',')
+        .map(String::from)
+        .collect();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect())
+        .collect();
+    (names, rows)
+}
