@@ -72,8 +72,8 @@ win64-tools:
 	fi
 
 # The Rust tests of `make test`: cargo-nextest where installed (the test binaries side by side),
-# else cargo test.
-CARGO_TEST := $(if $(shell cargo nextest --version 2>/dev/null),cargo nextest run --no-fail-fast \
+# else cargo test (`=`: asked only where `make test` uses it).
+CARGO_TEST = $(if $(shell cargo nextest --version 2>/dev/null),cargo nextest run --no-fail-fast \
   --cargo-quiet,cargo test --no-fail-fast) --workspace --exclude fmu-beam-py --release
 
 # The workspace but the Python extension, which `wheel` builds (maturin, for an explicit target).

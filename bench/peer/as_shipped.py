@@ -7,8 +7,8 @@ its own DefaultExperiment and solver settings, as a user runs it; its outputs sc
 the exact reference (bench/reference/<case>.csv) on the FMU's own output grid (error = max over
 the grid of |y - y_ref| / max |y_ref|, y_ref interpolated linearly where the grids differ); then
 Exudyn's cheapest run in build/bench/peer_points.csv (`sweep.py`) whose error ON THE SAME GRID
-(the FMU's) is at most ours, re-run here (`cheapest_peer`). Ours and Exudyn's runs alternate (ours, Exudyn's, ours, ...) so that both see the
-same load on a shared machine.
+(the FMU's) is at most ours, re-run here (`cheapest_peer`). Ours and Exudyn's runs alternate
+(ours, Exudyn's, ours, ...) so that both see the same load on a shared machine.
 
 Our time is the process CPU time of the whole call a user makes, in two forms, and of the run:
   * `fmu`: simulate_fmu(path): unzips the FMU, reads modelDescription.xml, loads the engine,
