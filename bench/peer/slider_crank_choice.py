@@ -1,0 +1,80 @@
+"""slider_crank as shipped (crank 3, rod 8 elements, fixed step 3.71e-4 s) against the accuracy
+study's own choice for it (crank 2, rod 4, 1.76e-3 s; the scene's comment says why it keeps the
+paper's mesh): both packaged from scenes/slider_crank.toml, run by fmpy.simulate_fmu on the FMU
+extracted once, in alternating rounds; the process CPU time of each call, the ratio per round
+(median, least-largest), and each run's error against bench/reference/c3_elastic.csv on the
+unit's grid (relative to the reference's largest value, as as_shipped.py scores).
+
+    .venv-bench/bin/python bench/peer/slider_crank_choice.py   # after `make release`
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from sweep import load_reference  # noqa: E402
+
+# (pattern, replacement): each must match exactly once in the shipped scene
+CHOICE = [
+    (r'max_step = 3\.71e-4', 'max_step = 1.76e-3'),
+    (r'(name = "crank"\nlength = 0\.152\nelements = )3', r'\g<1>2'),
+    (r'(name = "rod"\nlength = 0\.304\nelements = )8', r'\g<1>4'),
+]
+OUTPUTS = (('slider.position', 'slider_position'), ('rod.mid.deflection', 'rod_mid_deflection'))
+
+
+def package(scene_text, where, name):
+    toml, fmu = os.path.join(where, name + '.toml'), os.path.join(where, name + '.fmu')
+    with open(toml, 'w') as f:
+        f.write(scene_text)
+    subprocess.run([os.path.join(ROOT, 'target/release/fmu-harness'), 'package', toml, '-o', fmu,
+                    '--binary', 'linux64=' + os.path.join(ROOT, 'target/release/libfmu_beam.so')],
+                   check=True, stdout=subprocess.DEVNULL)
+    return fmu
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    ap.add_argument('--rounds', type=int, default=5)
+    args = ap.parse_args()
+    import fmpy
+    shipped = open(os.path.join(ROOT, 'scenes/slider_crank.toml')).read()
+    choice = shipped
+    for pattern, repl in CHOICE:
+        choice, n = re.subn(pattern, repl, choice)
+        if n != 1:
+            sys.exit('scenes/slider_crank.toml changed: %r matched %d times' % (pattern, n))
+    ref = load_reference('c3_elastic')
+    with tempfile.TemporaryDirectory() as where:
+        dirs = {name: fmpy.extract(package(text, where, name), os.path.join(where, name))
+                for name, text in (('shipped', shipped), ('choice', choice))}
+        cpu = {name: [] for name in dirs}
+        for k in range(args.rounds):
+            for name in (dirs if k % 2 == 0 else reversed(list(dirs))):
+                t0 = time.process_time()
+                res = fmpy.simulate_fmu(dirs[name], output=[o for o, _ in OUTPUTS])
+                cpu[name].append(time.process_time() - t0)
+                if k == 0:
+                    t = np.asarray(res['time'], dtype=float)
+                    errors = []
+                    for o, col in OUTPUTS:
+                        e = np.max(np.abs(res[o] - np.interp(t, ref['t'], ref[col])))
+                        errors.append('%s %.2e' % (col, e / np.max(np.abs(ref[col]))))
+                    print(name, 'error:', ', '.join(errors))
+    ratios = [c / s for c, s in zip(cpu['choice'], cpu['shipped'])]
+    for name, v in cpu.items():
+        print('%s CPU s: median %.4f (%.4f-%.4f)' % (name, np.median(v), min(v), max(v)))
+    print('choice / shipped: median %.3f (%.3f-%.3f), %d rounds, load average %.1f'
+          % (np.median(ratios), min(ratios), max(ratios), args.rounds, os.getloadavg()[0]))
+
+
+if __name__ == '__main__':
+    main()
