@@ -63,10 +63,12 @@ def venv(wheel, tmp_path_factory):
     measured(pip_install_s=round(time.perf_counter() - started, 2),
              wheel=wheel.name, wheel_bytes=wheel.stat().st_size)
     # then what the wheel declares it needs (numpy, pandas: Scene.modes, simulate, sweep), as a
-    # user's `pip install` brings it (from pip's cache where .venv already fetched it)
+    # user's `pip install` brings it (from pip's cache where .venv already fetched it); without
+    # compiling pandas' and numpy's modules ahead (9.3 -> 3.9 s here), which the tests' imports
+    # then compile as they load them
     subprocess.run(
         [sys.executable, "-m", "pip", "--python", str(root / "bin" / "python"), "install",
-         "--quiet", str(wheel)],
+         "--quiet", "--no-compile", str(wheel)],
         check=True,
     )
     env = {k: v for k, v in os.environ.items() if not k.startswith(("CARGO", "RUSTUP", "PYTHON"))}

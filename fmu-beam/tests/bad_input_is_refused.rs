@@ -2,7 +2,7 @@
 //! types, missing and unknown keys, NaN/Inf, huge and tiny numbers) are either accepted and
 //! run, or refused with a message naming the field; mutated FMU-state bytes are refused.
 
-mod common;
+use crate::common;
 use fmu_beam::{Engine, Scene};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};

@@ -1,6 +1,6 @@
 //! Case C2 (planar paper §5.2, CASES.md): the flexible pendulum released from horizontal.
 
-mod common;
+use crate::common;
 use common::{run, scene};
 
 /// Rigid compound pendulum of length L released from horizontal:

@@ -1,6 +1,6 @@
 //! Case C3 (planar paper §5.3, CASES.md): the elastic slider-crank driven by a crank torque.
 
-mod common;
+use crate::common;
 use common::{run, scene};
 
 const OUTS: [&str; 6] = [

@@ -1,7 +1,7 @@
 //! Case C4 (planar paper §5.4, CASES.md): the spin-up manoeuvre of an 8 m beam clamped to a
 //! driven hub, and centrifugal stiffening. The tip deflection is measured in the hub frame.
 
-mod common;
+use crate::common;
 use common::{run, scene};
 use fmu_beam::{Engine, EngineError, Scene};
 use std::f64::consts::TAU;

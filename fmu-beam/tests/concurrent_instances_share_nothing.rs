@@ -1,7 +1,7 @@
 //! Several instances in one process share nothing (issue 7): 8 threads, each running its own
 //! engine of a different scene concurrently, give bit-identical results to runs one by one.
 
-mod common;
+use crate::common;
 use common::{run, scene};
 
 const CASES: [(&str, &str); 8] = [

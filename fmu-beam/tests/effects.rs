@@ -2,7 +2,7 @@
 //! case's tolerance of the full model, that a term switched off is never evaluated, and that
 //! modal truncation keeps the lowest modes exactly and converges as modes are added.
 
-mod common;
+use crate::common;
 
 use common::{run, scene};
 use fmu_beam::integrator::{initial_state, Settings, Stats, Stepper};

@@ -10,7 +10,7 @@
 //! shipped scenes carry it (`geometric_stiffening = true`, as `effects = "auto"` decides); each
 //! case here runs both ways, so the test shows what the stiffness buys.
 
-mod common;
+use crate::common;
 use common::{reference, run, scene};
 use fmu_beam::Scene;
 

@@ -2,7 +2,7 @@
 //! stiff axial direction at extreme communication steps, a mechanism through its toggle
 //! positions. Each test prints the figure it asserts. (Flat memory: `memory_is_flat.rs`.)
 
-mod common;
+use crate::common;
 use common::{run, scene};
 use fmu_beam::{Engine, Scene};
 

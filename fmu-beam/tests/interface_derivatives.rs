@@ -4,7 +4,7 @@
 //! dependencies, against the same differences; references that are not (Real) outputs and
 //! inputs refused by name.
 
-mod common;
+use crate::common;
 
 use common::{scene, vr};
 use fmu_beam::{Binding, Causality, VarType};

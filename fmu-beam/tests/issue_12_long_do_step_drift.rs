@@ -11,7 +11,7 @@
 //!   (to land on a drive law's jump off the grid) is counted in `solver.split_steps` and logged;
 //! - a unit with an input lands on the communication points and gives the same answer.
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::Engine;
 

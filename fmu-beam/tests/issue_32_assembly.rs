@@ -3,7 +3,7 @@
 //! unit moves the parts together and logs which part it moved and by how much. Messages name
 //! the scene's parts by the names the user gave them.
 
-mod common;
+use crate::common;
 
 use fmu_beam::scene::SceneError;
 use fmu_beam::{Engine, Scene};

@@ -9,7 +9,7 @@
 //! Also: a pendulum of a stiff substructured beam swings as far with α as without (the rigid
 //! swing is never damped).
 
-mod common;
+use crate::common;
 
 use fmu_beam::Scene;
 

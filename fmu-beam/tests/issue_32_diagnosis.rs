@@ -5,7 +5,7 @@
 //! cause is unknown and gives the step and its time. The causes that hold are tested in
 //! `c4_spin_up.rs` (spin) and `tests/test_diagnosis.py` (inputs on small inertias).
 
-mod common;
+use crate::common;
 
 use common::scene;
 use fmu_beam::{Engine, EngineError};

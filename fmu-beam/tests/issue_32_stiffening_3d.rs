@@ -9,7 +9,7 @@
 //!   `formulation = "spatial"`, so that the 3D element runs it, agrees with the planar unit.
 //! - `auto` turns stiffening on in 3D for the spinning blade, with its reason.
 
-mod common;
+use crate::common;
 use common::{run, scene};
 use fmu_beam::{resolve_effects, Scene};
 

@@ -5,7 +5,7 @@
 //! proposed step within the stepper's, the joints closed (`Stepper::implausible`). A refused
 //! state changes nothing; every shipped scene's own states are accepted.
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::{Engine, EngineError};
 

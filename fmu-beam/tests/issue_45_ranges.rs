@@ -3,7 +3,7 @@
 //! and the unit refuse it alike). Each scene below was accepted before; each message printed
 //! 1e300 as a number of 301 digits (cut to 80 characters).
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::{Engine, Scene, SceneError};
 

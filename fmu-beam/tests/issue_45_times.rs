@@ -3,7 +3,7 @@
 //! a stop time is kept, and a start time or a step that double precision cannot advance is
 //! refused with the reason, never an fmi2OK without motion.
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::{Engine, EngineError};
 

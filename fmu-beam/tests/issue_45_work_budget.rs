@@ -5,7 +5,7 @@
 //! `worst_do_step_of_every_shipped_scene` (ignored: a benchmark, run it with `--ignored
 //! --nocapture`) measures each scene's doStep(0, 1e6); no test asserts a time.
 
-mod common;
+use crate::common;
 use common::vr;
 use fmu_beam::integrator::{work_units, IterationMatrix, LinearSolver, DEFAULT_STEP_BUDGET};
 use fmu_beam::mechanics::{Equations, Mechanics};

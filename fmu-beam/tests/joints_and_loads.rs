@@ -1,7 +1,7 @@
 //! Loads, Rayleigh damping and the refusal of mechanisms that cannot be built: checks against
 //! closed forms, and the messages that name the joints.
 
-mod common;
+use crate::common;
 use common::run;
 use fmu_beam::{Engine, EngineError, Scene};
 

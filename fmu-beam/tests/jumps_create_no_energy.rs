@@ -12,7 +12,7 @@
 //!   0.6999999999999961 s, 4e-15 s before the torque's cut-off. The jump was taken for one
 //!   already passed and never met: 2.6e-4 J made (0.45 % of the work).
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::Engine;
 

@@ -3,7 +3,7 @@
 //! fmi2DeSerializeFMUstate of changed bytes), `solver.max_step` has a bound under which the
 //! answer is right, and a communication step that would run for hours ends in a Discard.
 
-mod common;
+use crate::common;
 use common::{scene, vr};
 use fmu_beam::{Engine, EngineError, Scene};
 use std::time::Instant;

@@ -2,7 +2,7 @@
 //! that a 3D scene whose motion is planar runs with the planar element, the fast variants as
 //! scenes (frozen inertia, a matrix file) against the full model, and the canonical text.
 
-mod common;
+use crate::common;
 
 use common::{run, scene, vr};
 use fmu_beam::mechanics::SpatialSection;

@@ -3,7 +3,7 @@
 //! checked against the unit's other outputs, a closed form and each other; reading them does
 //! not change the run.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_beam::{Engine, Scene};
 

@@ -9,7 +9,7 @@
 //! (`a_wrong_estimate_fails`); a shipped scene has a table or says in a comment why it has none
 //! (`every_shipped_scene_states_its_accuracy_or_why_not`).
 
-mod common;
+use crate::common;
 use common::{run, scene};
 use fmu_beam::Scene;
 use std::path::Path;

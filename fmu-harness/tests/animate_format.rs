@@ -2,7 +2,7 @@
 //! .html the page; any other extension is refused before the run is made, with nothing written
 //! (before, `-o anim.gif` wrote an HTML page under the GIF's name, silently).
 
-mod common;
+use crate::common;
 use common::*;
 use std::ffi::OsStr;
 

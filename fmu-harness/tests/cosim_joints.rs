@@ -10,7 +10,7 @@
 //! - a 3D pair, the double pendulum split at its spherical pin (the lower beam swinging out of
 //!   the upper one's plane), equals its monolithic twin to the pin tolerance.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::cosim::{self, system::System, CosimError};
 use fmu_harness::slave::Slave;

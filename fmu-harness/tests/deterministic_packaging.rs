@@ -2,7 +2,7 @@
 //! byte-identical FMU (fixed zip timestamps, order and permissions; no generation date), and a
 //! different binary gives a different GUID.
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

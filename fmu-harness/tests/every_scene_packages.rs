@@ -3,7 +3,7 @@
 //! modelDescription.xml is well-formed XML 1.0 (issue 45: U+FFFE in a description made fmpy
 //! raise XMLSyntaxError).
 
-mod common;
+use crate::common;
 use common::*;
 use std::path::Path;
 

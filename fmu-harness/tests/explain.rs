@@ -2,7 +2,7 @@
 //! setting, reason and cost share; the same text is the FMU's documentation; a wrong `effects`
 //! or an accuracy statement for no output is refused naming the field.
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

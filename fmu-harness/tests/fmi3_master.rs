@@ -11,7 +11,7 @@
 //!
 //! The whole runs are `tests/test_fmi3.py`'s (every shipped scene).
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::cosim::{self, system::System};
 use fmu_harness::platform::FmiVersion;

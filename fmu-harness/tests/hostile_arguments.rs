@@ -14,7 +14,7 @@
 //!
 //! Each run is a child process bounded in time: a hang or an abort fails.
 
-mod common;
+use crate::common;
 use common::*;
 use std::io::Write;
 use std::os::unix::process::ExitStatusExt;

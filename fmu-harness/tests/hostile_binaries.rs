@@ -4,7 +4,7 @@
 //! of them, is refused naming what is missing; so is one without the FMI 3.0 functions for a
 //! `--fmi-version 3` unit. Each run is bounded in time: a hang fails.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::engine_library::MAX_LIBRARY_BYTES;
 use std::path::Path;

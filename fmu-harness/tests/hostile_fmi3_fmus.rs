@@ -6,7 +6,7 @@
 //! refused with a message that says what, without quoting what could not be read, no panic, no
 //! extraction folder left behind.
 
-mod common;
+use crate::common;
 use common::hostile::*;
 use common::*;
 use std::path::Path;

@@ -7,7 +7,7 @@
 //!
 //! Each run is a child process with its own TMPDIR, bounded in time: a hang fails the test.
 
-mod common;
+use crate::common;
 use common::hostile::*;
 use common::*;
 use std::path::{Path, PathBuf};

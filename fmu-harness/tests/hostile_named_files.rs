@@ -4,7 +4,7 @@
 //! quoted: a system file or CSV holding a line of /etc/passwd does not print it. Each run is a
 //! child process bounded in time: a hang fails.
 
-mod common;
+use crate::common;
 use common::*;
 use std::path::Path;
 use std::process::{Command, Stdio};

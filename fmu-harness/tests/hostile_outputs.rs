@@ -7,7 +7,7 @@
 //! a link to /dev/null, and `animate --gif` opened a FIFO for writing and blocked. Each run is
 //! a child bounded in time: a hang fails. No test names a real device as the output.
 
-mod common;
+use crate::common;
 use common::*;
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};

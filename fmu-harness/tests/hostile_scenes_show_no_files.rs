@@ -6,7 +6,7 @@
 //! named file (each holds a secret marker), on a message longer than a few lines, and on a
 //! refusal that takes more than a second. Stops after [`BUDGET_S`] seconds.
 
-mod common;
+use crate::common;
 use fmu_beam::Scene;
 use fmu_harness::package;
 use fmu_harness::platform::Platform;

@@ -2,7 +2,7 @@
 //! appears exactly once in modelDescription.xml, with its value reference, causality and
 //! variability, and ModelStructure lists every output.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_beam::{Causality, VariableTable};
 

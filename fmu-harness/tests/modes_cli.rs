@@ -2,7 +2,7 @@
 //! modes, speed and hub), its figures are the closed forms, and `--campbell` writes a CSV whose
 //! columns follow Southwell's law and a PNG.
 
-mod common;
+use crate::common;
 
 use common::{harness, scratch};
 use std::f64::consts::TAU;

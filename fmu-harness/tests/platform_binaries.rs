@@ -3,7 +3,7 @@
 //! the GUID changes when either changes, and a library that is not what its platform needs, or
 //! a platform given twice, is refused before anything is written.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::platform::Platform;
 

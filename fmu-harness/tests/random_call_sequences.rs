@@ -7,7 +7,7 @@
 //! fmu-beam/src/fmi2/abi_tests.rs; arrays of mismatched length cannot be sent: the binding
 //! refuses to build such a call, and a C master that did would overrun its own arrays.)
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::fmi2_binding::{FmuState, Status};
 use fmu_harness::slave::{Slave, SlaveError};

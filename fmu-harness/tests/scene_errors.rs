@@ -1,7 +1,7 @@
 //! A wrong scene is refused before anything is written: exit status 2, no panic, no .fmu, and
 //! a message that names the file, the field and the rule.
 
-mod common;
+use crate::common;
 use common::*;
 
 /// (case, edit of the C1 text, words the message must contain besides the file name)

@@ -2,7 +2,7 @@
 //! fmi2Warning messages went nowhere before: a motion drive that turned a beam at
 //! initialization did so silently), and the CSV on standard output stays clean.
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

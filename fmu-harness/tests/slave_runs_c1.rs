@@ -3,7 +3,7 @@
 //! at h = 1e-3 completes, an FMU state rolls back bit for bit, a refused call carries the FMU's
 //! message, and `fmu-harness simulate` writes the CSV.
 
-mod common;
+use crate::common;
 use common::*;
 use fmu_harness::fmi2_binding::{FmuState, Status};
 use fmu_harness::slave::{Slave, SlaveError};
