@@ -32,9 +32,10 @@ WIN64_DIR      := target/win64
 WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
 WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
 WIN64_TEST_PACKAGES := wine64
-WIN64_BUILD    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
+WIN64_CARGO    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
   CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
-  nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+  /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+WIN64_BUILD    := nice $(WIN64_CARGO)
 # Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
 WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/dev/null | grep -c 'install ok installed')" == $(words $(WIN64_PACKAGES)) ]]
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
@@ -219,30 +220,37 @@ demo: .venv fmus
 	$(PY) tests/demo_animations.py
 
 # What runs side by side, so that a fresh clone's `make test` keeps both cores busy (issue 46
-# item 6): the Rust tests' compile, which builds the engine, the packager and its command on
-# the way, starts at once in the background, then the rest of the Linux build (the bench
-# command; log: build/release.log): in one cargo run the engine's tests compile beside the
-# packager, where two runs in turn wait on each crate of the chain faer, fmu-beam, fmu-harness
-# (44, 43, 18 s here, `cargo build --timings`). Meanwhile Python's venv and Debian's packages
-# install side by side (about two minutes of download and unpacking on a fresh machine, little
-# CPU); then the Windows engine
-# (log: build/win64/build.log) and the wheel's first pass (log: build/wheel/prebuild.log; its own
-# $(WHEEL_DIR), so no cargo lock is shared with the Linux build) compile niced in the background,
-# while `release` and the Rust tests run in front (each waits for cargo's lock and finds its
-# units built); `wheel` then waits for both (maturin.lock, cargo's lock) and finds them built.
-# The Rust tests run under cargo-nextest where it is installed (every test binary side by side;
-# `cargo test` runs them one after the other and the long single tests leave a core idle).
-# pytest runs in three processes: tests/test_no_leaks.py (1e4 cycles under valgrind, 2-3 min
-# on one core; its own --basetemp, its output after the rest's), niced in the background as
-# soon as the Linux engine is built, on a unit of its own that carries that engine only (so
-# that it fills what the builds leave of the cores: their last crates compile one at a time),
-# and the rest in two workers (pytest-xdist, a file's tests in one worker: its module fixtures
-# are built once).
-# The fuzz stage runs last, shorter than `make fuzz` alone (issue 45 item 9: a couple of
-# minutes), its two halves side by side (each is one process, bounded in time; outputs in
-# build/fuzz.log and build/fuzz-python.log, shown after both).
+# item 6; every stage is CPU-bound, so what counts is that no core idles: `vmstat 10` beside a
+# fresh clone's run read 0 % idle but where one job was left alone):
+# - the Rust tests' compile, which builds the engine, the packager and its command on the way,
+#   starts at once in the background, then the rest of the Linux build (the bench command; log:
+#   build/release.log): in one cargo run the engine's tests compile beside the packager, where
+#   two runs in turn wait on each crate of the chain faer, fmu-beam, fmu-harness (44, 43, 18 s
+#   here, `cargo build --timings`). Meanwhile Python's venv and Debian's packages install side
+#   by side (about two minutes of download and unpacking on a fresh machine, little CPU).
+# - Then the Windows engine (log: build/win64/build.log), at normal priority, so that its own
+#   chain of single crates (its std, faer, fmu-beam) runs beside the Rust tests instead of
+#   alone at the end, and the wheel's first pass (log: build/wheel/prebuild.log; its own
+#   $(WHEEL_DIR), so no cargo lock is shared with the Linux build), niced, in the background,
+#   while `release` and the Rust tests run in front (each waits for cargo's lock and finds its
+#   units built).
+# - tests/test_no_leaks.py (1e4 cycles under valgrind, 2-3 min on one core; its own --basetemp,
+#   its output after the rest's), niced in the background as soon as the Linux engine is built,
+#   on a unit of its own that carries that engine only.
+# - The Rust tests under cargo-nextest where it is installed (every test binary side by side;
+#   `cargo test` runs a binary's tests in threads).
+# - The fuzz stage's FMI half (tests/fuzz/fmi_calls.py; issue 45 item 9, shorter than `make
+#   fuzz` alone, bounded in time, output in build/fuzz.log) once the Windows engine is built, at
+#   normal priority, beside the units' packaging and the end of the wheel's build (its last
+#   crates compile one at a time); `wheel` then waits for its first pass (maturin.lock) and
+#   finds it built.
+# - pytest in two workers (pytest-xdist, a file's tests in one worker: its module fixtures are
+#   built once), then the fuzz stage's Python half (it needs the wheel; build/fuzz-python.log).
 TEST_FUZZ_SECONDS        ?= 60
 TEST_FUZZ_PYTHON_SECONDS ?= 30
+# The exit status a background job of `test` left in the file $(1) (waits up to 30 min for it;
+# 1 when it never came).
+rc_of = for ((i = 0; i < 1800; i++)); do [[ -e $(1) ]] && break; sleep 1; done; cat $(1) 2>/dev/null || echo 1
 test:
 	@mkdir -p build; echo "release: the Rust tests' compile and the Linux build in the background (build/release.log)"; \
 	{ $(CARGO_TEST_BUILD) && cargo build --release --workspace --exclude fmu-beam-py; } </dev/null >build/release.log 2>&1 &
@@ -250,12 +258,12 @@ test:
 	@mkdir -p build/win64; \
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  echo "win64: building the Windows engine in the background (build/win64/build.log)"; \
-	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
+	  $(WIN64_CARGO) </dev/null >build/win64/build.log 2>&1 & \
 	fi; \
-	mkdir -p build/wheel; echo "wheel: its first pass in the background (build/wheel/prebuild.log)"; \
+	mkdir -p build/wheel; echo "wheel: its first pass in the background, niced (build/wheel/prebuild.log)"; \
 	$(MATURIN) --out build/wheel/prebuild </dev/null >build/wheel/prebuild.log 2>&1 &
 	$(MAKE) --no-print-directory release
-	@mkdir -p build/leaks; rm -f build/pytest-leaks.rc; \
+	@mkdir -p build/leaks; rm -f build/pytest-leaks.rc build/fuzz.rc; \
 	$(HARNESS) package scenes/cantilever_free_vibration.toml -o build/leaks/cantilever_free_vibration.fmu \
 	  --binary linux64=$(ENGINE) >/dev/null; \
 	echo "pytest: tests/test_no_leaks.py in the background, niced (build/pytest-leaks.log)"; \
@@ -263,16 +271,17 @@ test:
 	    -q -p no:cacheprovider --basetemp=build/pytest-leaks >build/pytest-leaks.log 2>&1; \
 	  echo $$? >build/pytest-leaks.rc; } </dev/null &
 	$(CARGO_TEST)
-	$(MAKE) --no-print-directory wheel
+	$(MAKE) --no-print-directory win64
+	@echo "make fuzz: in the background (build/fuzz.log)"; \
+	{ $(PY) tests/fuzz/fmi_calls.py --engine $(ENGINE) --harness $(HARNESS) --seed $(FUZZ_SEED) \
+	    --seconds $(TEST_FUZZ_SECONDS) >build/fuzz.log 2>&1; echo $$? >build/fuzz.rc; } </dev/null &
 	$(MAKE) --no-print-directory fmus
+	$(MAKE) --no-print-directory wheel
 	@rest=0; WIN64=$(WIN64) $(PY) -m pytest tests -q -n 2 --dist loadfile --ignore=tests/test_no_leaks.py || rest=$$?; \
-	for ((i = 0; i < 1800; i++)); do [[ -e build/pytest-leaks.rc ]] && break; sleep 1; done; \
-	leaked=$$(cat build/pytest-leaks.rc 2>/dev/null || echo 1); \
+	pyfuzzed=0; $(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS) \
+	  >build/fuzz-python.log 2>&1 || pyfuzzed=$$?; \
+	leaked=$$($(call rc_of,build/pytest-leaks.rc)); fuzzed=$$($(call rc_of,build/fuzz.rc)); \
 	echo "pytest tests/test_no_leaks.py:"; cat build/pytest-leaks.log; \
-	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(TEST_FUZZ_SECONDS) >build/fuzz.log 2>&1 & fuzz=$$!; \
-	$(MAKE) --no-print-directory fuzz-python FUZZ_PYTHON_SECONDS=$(TEST_FUZZ_PYTHON_SECONDS) \
-	  >build/fuzz-python.log 2>&1 & pyfuzz=$$!; \
-	fuzzed=0; wait $$fuzz || fuzzed=$$?; pyfuzzed=0; wait $$pyfuzz || pyfuzzed=$$?; \
 	echo "make fuzz:"; cat build/fuzz.log; echo "make fuzz-python:"; cat build/fuzz-python.log; \
 	exit $$(( rest || leaked || fuzzed || pyfuzzed ))
 
