@@ -228,22 +228,21 @@ demo: .venv fmus
 #   two runs in turn wait on each crate of the chain faer, fmu-beam, fmu-harness (44, 43, 18 s
 #   here, `cargo build --timings`). Meanwhile Python's venv and Debian's packages install side
 #   by side (about two minutes of download and unpacking on a fresh machine, little CPU).
-# - Then the Windows engine (log: build/win64/build.log), at normal priority, so that its own
-#   chain of single crates (its std, faer, fmu-beam) runs beside the Rust tests instead of
-#   alone at the end, and the wheel's first pass (log: build/wheel/prebuild.log; its own
-#   $(WHEEL_DIR), so no cargo lock is shared with the Linux build), niced, in the background,
-#   while `release` and the Rust tests run in front (each waits for cargo's lock and finds its
-#   units built).
+# - Then the Windows engine (log: build/win64/build.log) and the wheel's first pass (log:
+#   build/wheel/prebuild.log; its own $(WHEEL_DIR), so no cargo lock is shared with the Linux
+#   build), niced, in the background, while `release` and the Rust tests run in front (each
+#   waits for cargo's lock and finds its units built). Run at normal priority, the Windows
+#   engine slowed the Rust tests as much as it saved at the end (980 s against 981).
 # - tests/test_no_leaks.py (1e4 cycles under valgrind, 2-3 min on one core; its own --basetemp,
 #   its output after the rest's), niced in the background as soon as the Linux engine is built,
 #   on a unit of its own that carries that engine only.
 # - The Rust tests under cargo-nextest where it is installed (every test binary side by side;
 #   `cargo test` runs a binary's tests in threads).
 # - The fuzz stage's FMI half (tests/fuzz/fmi_calls.py; issue 45 item 9, shorter than `make
-#   fuzz` alone, bounded in time, output in build/fuzz.log) once the Windows engine is built, at
-#   normal priority, beside the units' packaging and the end of the wheel's build (its last
-#   crates compile one at a time); `wheel` then waits for its first pass (maturin.lock) and
-#   finds it built.
+#   fuzz` alone, bounded in time, output in build/fuzz.log) once the wheel's first pass is done
+#   (maturin.lock), at normal priority, beside the end of the Windows engine's build (its last
+#   crates, faer and fmu-beam, compile one at a time: a core idled there for a minute) and the
+#   units' packaging; `wheel` then finds its first pass built.
 # - pytest in two workers (pytest-xdist, a file's tests in one worker: its module fixtures are
 #   built once), then the fuzz stage's Python half (it needs the wheel; build/fuzz-python.log).
 TEST_FUZZ_SECONDS        ?= 60
@@ -258,7 +257,7 @@ test:
 	@mkdir -p build/win64; \
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  echo "win64: building the Windows engine in the background (build/win64/build.log)"; \
-	  $(WIN64_CARGO) </dev/null >build/win64/build.log 2>&1 & \
+	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
 	fi; \
 	mkdir -p build/wheel; echo "wheel: its first pass in the background, niced (build/wheel/prebuild.log)"; \
 	$(MATURIN) --out build/wheel/prebuild </dev/null >build/wheel/prebuild.log 2>&1 &
@@ -271,8 +270,7 @@ test:
 	    -q -p no:cacheprovider --basetemp=build/pytest-leaks >build/pytest-leaks.log 2>&1; \
 	  echo $$? >build/pytest-leaks.rc; } </dev/null &
 	$(CARGO_TEST)
-	$(MAKE) --no-print-directory win64
-	@echo "make fuzz: in the background (build/fuzz.log)"; \
+	@flock build/wheel/maturin.lock true; echo "make fuzz: in the background (build/fuzz.log)"; \
 	{ $(PY) tests/fuzz/fmi_calls.py --engine $(ENGINE) --harness $(HARNESS) --seed $(FUZZ_SEED) \
 	    --seconds $(TEST_FUZZ_SECONDS) >build/fuzz.log 2>&1; echo $$? >build/fuzz.rc; } </dev/null &
 	$(MAKE) --no-print-directory fmus
