@@ -32,10 +32,9 @@ WIN64_DIR      := target/win64
 WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
 WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
 WIN64_TEST_PACKAGES := wine64
-WIN64_CARGO    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
+WIN64_BUILD    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
   CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
-  /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
-WIN64_BUILD    := nice $(WIN64_CARGO)
+  nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
 # Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
 WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/dev/null | grep -c 'install ok installed')" == $(words $(WIN64_PACKAGES)) ]]
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
@@ -73,10 +72,9 @@ win64-tools:
 	fi
 
 # What `make test` needs from Debian (tools, browser and win64-tools above) in one apt-get run:
-# an update and an install, not three of each (about 40 s less on a fresh machine). Where the
-# whole list cannot be installed, the required part (valgrind, gcc, chromium) is tried alone and
-# the Windows toolchain goes, as win64-tools allows.
-TEST_REQUIRED := valgrind gcc libc6-dev chromium
+# an update and an install, not three of each. Where the whole list cannot be installed, the
+# required part (valgrind, gcc, chromium) is tried alone and the Windows toolchain goes, as
+# win64-tools allows.
 test-tools:
 	@pkgs=(); \
 	{ command -v gcc && command -v valgrind; } >/dev/null || pkgs+=(valgrind gcc libc6-dev); \
