@@ -3,7 +3,7 @@ study's own choice for it (crank 2, rod 4, 1.76e-3 s; the scene's comment says w
 paper's mesh): both packaged from scenes/slider_crank.toml, run by fmpy.simulate_fmu on the FMU
 extracted once, in alternating rounds; the process CPU time of each call, the ratio per round
 (median, least-largest), and each run's error against bench/reference/c3_elastic.csv on the
-unit's grid (relative to the reference's largest value, as as_shipped.py scores).
+unit's grid (relative to the reference's largest value: as_shipped.py's score).
 
     .venv-bench/bin/python bench/peer/slider_crank_choice.py   # after `make release`
 """
@@ -20,6 +20,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+from as_shipped import output, score  # noqa: E402
 from sweep import load_reference  # noqa: E402
 
 # (pattern, replacement): each must match exactly once in the shipped scene
@@ -63,12 +64,8 @@ def main():
                 res = fmpy.simulate_fmu(dirs[name], output=[o for o, _ in OUTPUTS])
                 cpu[name].append(time.process_time() - t0)
                 if k == 0:
-                    t = np.asarray(res['time'], dtype=float)
-                    errors = []
-                    for o, col in OUTPUTS:
-                        e = np.max(np.abs(res[o] - np.interp(t, ref['t'], ref[col])))
-                        errors.append('%s %.2e' % (col, e / np.max(np.abs(ref[col]))))
-                    print(name, 'error:', ', '.join(errors))
+                    print(name, 'error:', ', '.join('%s %.2e' % (col, score(res, output(o), ref, col))
+                                                    for o, col in OUTPUTS))
     ratios = [c / s for c, s in zip(cpu['choice'], cpu['shipped'])]
     for name, v in cpu.items():
         print('%s CPU s: median %.4f (%.4f-%.4f)' % (name, np.median(v), min(v), max(v)))
