@@ -49,22 +49,28 @@ $(STAMP): requirements.txt
 	$(VENV)/bin/pip install --quiet -r requirements.txt
 	touch $@
 
+# Exit status 0 when each test tool is there: valgrind (the leak test) and gcc (its C master);
+# the browser; the Windows build's tools and Wine (its test).
+TOOLS_THERE      := { command -v gcc && command -v valgrind; } >/dev/null
+BROWSER_THERE    := { command -v chromium || command -v chromium-browser; } >/dev/null
+WIN64_TOOLS_THERE := $(WIN64_READY) && command -v wine >/dev/null
+
 # System tools the tests use: valgrind (the leak test) and gcc (its C master), from Debian.
 tools:
-	@command -v gcc >/dev/null && command -v valgrind >/dev/null || { \
+	@$(TOOLS_THERE) || { \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind gcc libc6-dev; }
 
 # The browser the animation tests open the HTML player in: Debian's chromium (Playwright, from
 # requirements.txt, drives it; it downloads no browser of its own).
 browser:
-	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || { \
+	@$(BROWSER_THERE) || { \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
 
 # The Windows build's tools (and Wine, for its test), from Debian, when missing. A machine where
 # they cannot be installed (not Debian, not root, no registry) goes on without them.
 win64-tools:
 	@[[ "$(WIN64)" == 0 ]] && exit 0; \
-	if ! $(WIN64_READY) || ! command -v wine >/dev/null; then \
+	if ! { $(WIN64_TOOLS_THERE); }; then \
 	  echo "win64-tools: installing $(WIN64_PACKAGES) $(WIN64_TEST_PACKAGES) from Debian"; \
 	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	      $(WIN64_PACKAGES) $(WIN64_TEST_PACKAGES) >/dev/null; } \
@@ -77,10 +83,10 @@ win64-tools:
 # win64-tools allows.
 test-tools:
 	@pkgs=(); \
-	{ command -v gcc && command -v valgrind; } >/dev/null || pkgs+=(valgrind gcc libc6-dev); \
-	command -v chromium >/dev/null || command -v chromium-browser >/dev/null || pkgs+=(chromium); \
+	$(TOOLS_THERE) || pkgs+=(valgrind gcc libc6-dev); \
+	$(BROWSER_THERE) || pkgs+=(chromium); \
 	required=$${#pkgs[@]}; \
-	if [[ "$(WIN64)" != 0 ]] && { ! $(WIN64_READY) || ! command -v wine >/dev/null; }; then \
+	if [[ "$(WIN64)" != 0 ]] && ! { $(WIN64_TOOLS_THERE); }; then \
 	  pkgs+=($(WIN64_PACKAGES) $(WIN64_TEST_PACKAGES)); fi; \
 	(( $${#pkgs[@]} )) || exit 0; \
 	echo "test-tools: installing $${pkgs[*]} from Debian"; \
@@ -92,14 +98,16 @@ test-tools:
 
 # The Rust tests of `make test`: cargo-nextest where installed (the test binaries side by side),
 # else cargo test (`=`: asked only where `make test` uses it).
+# The Linux build's crates: the workspace but the Python extension, which `wheel` builds
+# (maturin, for an explicit target).
+LINUX_CRATES := --workspace --exclude fmu-beam-py --release
 CARGO_TEST = $(if $(shell cargo nextest --version 2>/dev/null),cargo nextest run --no-fail-fast \
-  --cargo-quiet,cargo test --no-fail-fast) --workspace --exclude fmu-beam-py --release
+  --cargo-quiet,cargo test --no-fail-fast) $(LINUX_CRATES)
 # What it compiles, asked for alone (the same units: `make test` starts it early, in the background).
-CARGO_TEST_BUILD := cargo test --no-run --workspace --exclude fmu-beam-py --release
+CARGO_TEST_BUILD := cargo test --no-run $(LINUX_CRATES)
 
-# The workspace but the Python extension, which `wheel` builds (maturin, for an explicit target).
 release:
-	cargo build --release --workspace --exclude fmu-beam-py
+	cargo build $(LINUX_CRATES)
 
 # The Windows engine ($(WIN64_ENGINE)), when the toolchain is there; about 5 minutes from clean
 # on 2 cores (the standard library is built too), seconds when up to date. Waits for a build
@@ -250,7 +258,7 @@ TEST_FUZZ_PYTHON_SECONDS ?= 30
 rc_of = for ((i = 0; i < 1800; i++)); do [[ -e $(1) ]] && break; sleep 1; done; cat $(1) 2>/dev/null || echo 1
 test:
 	@mkdir -p build; echo "release: the Rust tests' compile and the Linux build in the background (build/release.log)"; \
-	{ $(CARGO_TEST_BUILD) && cargo build --release --workspace --exclude fmu-beam-py; } </dev/null >build/release.log 2>&1 &
+	{ $(CARGO_TEST_BUILD) && cargo build $(LINUX_CRATES); } </dev/null >build/release.log 2>&1 &
 	$(MAKE) --no-print-directory -j2 -Otarget .venv test-tools
 	@mkdir -p build/win64; \
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
