@@ -25,14 +25,15 @@ SCENES  := $(wildcard scenes/*.toml)
 # x86_64 windows-gnu target, linked by mingw-w64. win7: its std draws random numbers from
 # RtlGenRandom (advapi32) instead of ProcessPrng (bcryptprimitives.dll, Windows 10 on, absent
 # from Wine 8), so the DLL is built for Windows 7 and later and runs under Wine: the binary the
-# Wine test runs is the one we ship. Its own target dir, so it can build while the Linux one does.
+# Wine test runs is the one we ship. Its own target dir, so it can build while the Linux one does;
+# its build scripts link with the system's cc (not the Linux build's zig, below).
 WIN64          ?= auto
 WIN64_TARGET   := x86_64-win7-windows-gnu
 WIN64_DIR      := target/win64
 WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
 WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
 WIN64_TEST_PACKAGES := wine64
-WIN64_BUILD    := env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
+WIN64_BUILD    := env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
   CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
   nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
 # Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
@@ -42,12 +43,34 @@ WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian pa
 
 .PHONY: .venv tools browser win64-tools test-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies bench-exhaustive bench-scaling example-split example-hinge example-arm example-sweep example-droop clean distclean
 
-# The Python environment: created once, refreshed when requirements.txt changes.
+# The Python environment: created once, refreshed when requirements.txt changes. (Not created
+# again where it is there: a build may be linking through its zig, below, meanwhile.)
 .venv: $(STAMP)
 $(STAMP): requirements.txt
-	$(PYTHON3) -m venv $(VENV)
+	[[ -x $(PY) ]] || $(PYTHON3) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet -r requirements.txt
 	touch $@
+
+# The linker of every Linux binary the Makefile builds (the engine, the packager, the tests, the
+# wheel's extension module): zig (ziglang, from PyPI), through maturin's wrapper of it (`maturin
+# zig cc`, which turns rustc's linker arguments into zig's), against glibc 2.28's symbols. A plain
+# link on this Debian (glibc 2.36) binds hypot, pow, exp, log and the pthread keys to glibc
+# 2.29-2.35 symbol versions, so an FMU's linux64 engine would not load on an older Linux (RHEL 8,
+# Ubuntu 20.04); linked so it needs glibc 2.28 (tests/test_fmus_portable.py checks every FMU), and
+# the wheel (manylinux_2_28, below) can carry the same engine and share every compiled unit with
+# the Linux build: cargo keeps units apart by linker, and the wheel must be linked so. Cargo reads
+# the linker from the environment; the script lives in the venv, whose maturin and ziglang (their
+# versions from requirements.txt, installed first, in seconds) it calls. A plain `cargo build`
+# outside make links with the system's cc, as cargo does by default.
+LINKER := $(VENV)/bin/cc-glibc-2.28
+export CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER := $(abspath $(LINKER))
+$(LINKER): requirements.txt
+	[[ -x $(PY) ]] || $(PYTHON3) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet $$(grep -E '^(maturin|ziglang)==' requirements.txt)
+	printf '%s\n' '#!/bin/sh' \
+	  'export CARGO_ZIGBUILD_ZIG_COMMAND="$(abspath $(PY))" CARGO_ZIGBUILD_ZIG_COMMAND_ARGS="-m ziglang"' \
+	  'exec "$(abspath $(VENV))/bin/maturin" zig cc -- -g -fno-sanitize=all -target x86_64-linux-gnu.2.28 "$$@"' >$@.tmp
+	chmod +x $@.tmp && mv $@.tmp $@
 
 # Exit status 0 when each test tool is there: valgrind (the leak test) and gcc (its C master);
 # the browser; the Windows build's tools and Wine (its test).
@@ -106,7 +129,7 @@ CARGO_TEST = $(if $(shell cargo nextest --version 2>/dev/null),cargo nextest run
 # What it compiles, asked for alone (the same units: `make test` starts it early, in the background).
 CARGO_TEST_BUILD := cargo test --no-run $(LINUX_CRATES)
 
-release:
+release: $(LINKER)
 	cargo build $(LINUX_CRATES)
 
 # The Windows engine ($(WIN64_ENGINE)), when the toolchain is there; about 5 minutes from clean
@@ -144,38 +167,31 @@ fmus: release win64
 # manylinux_2_28_x86_64.whl, one wheel for every CPython >= 3.9 on x86-64 Linux with glibc >= 2.28,
 # with the packager (the extension module fmu_beam._native, PyO3) and both engines as package data
 # (python/fmu_beam/engines/, which git ignores), so that its FMUs carry linux64 and win64.
-# manylinux_2_28: a plain link on this Debian (glibc 2.36) binds hypot, pow, exp and the pthread
-# keys to glibc 2.29-2.35 symbol versions, so maturin links with zig (ziglang, from PyPI) against
-# glibc 2.28's (`auditwheel show dist/*.whl` says which tag the wheel deserves). The linux64 engine
-# must be linked so too; maturin's cargo build makes it on the way (fmu-beam is a cdylib too), so a
-# first pass builds everything, the engine is copied in, and a second pass (nothing left to
-# compile) packs the wheel. It builds in $(WHEEL_DIR), apart from target/: it compiles every
-# dependency again for the explicit target anyway, and apart it takes no lock the Linux build
-# holds, so `make test` runs its first pass in the background from the start. The win64 engine
-# is `make win64`'s, made (or waited for) after the first pass. The wheel is then
-# installed into .venv (its dependencies are requirements.txt's), where the tests of the Python
-# API import it.
+# maturin builds the extension module in target/ through the Linux build's linker (LINKER above:
+# glibc 2.28, which maturin's manylinux_2_28 audit checks), so it finds every unit but its own
+# crate and PyO3 built, and the linux64 engine it carries is the FMUs' ($(ENGINE)). Two things
+# keep the units shared: no --zig or --target (maturin would pass an explicit target and its own
+# linker), and the same features: cargo resolves features per build, and PyO3 asks more of syn
+# and once_cell than the rest of the workspace does, so fmu-bench (bench/Cargo.toml) asks for them
+# too; where they differ, maturin compiles every dependency again (a minute or two; `maturin
+# build -v` says "Dirty ... info of dependency ... changed"). The win64 engine is `make win64`'s.
+# The wheel is then installed into .venv (its dependencies are requirements.txt's), where the
+# tests of the Python API import it. A pass with no engines in place (`make test` runs one into
+# build/wheel/early in the background, to compile) packs a wheel without them.
 WHEEL_ENGINES := python/fmu_beam/engines
-WHEEL_TARGET  := x86_64-unknown-linux-gnu
-WHEEL_DIR     := target/wheel
-# Every maturin pass holds build/wheel/maturin.lock: cargo's own lock serializes the compiles, but
-# maturin then stages the library at one fixed path of $(WHEEL_DIR), and two passes at once (the
-# background first pass still running when `wheel` starts) race on it ("failed to stage ...").
-MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" CARGO_TARGET_DIR=$(WHEEL_DIR) \
-  flock build/wheel/maturin.lock nice $(VENV)/bin/maturin build --release --zig \
-  --compatibility manylinux_2_28
-wheel: .venv
-	rm -rf $(WHEEL_ENGINES) build/wheel/first dist/fmu_beam-*.whl
-	mkdir -p build/wheel
-	$(MATURIN) --out build/wheel/first
-	rm -rf build/wheel/prebuild
+# Every maturin pass holds build/wheel/maturin.lock: maturin stages the library at one fixed path
+# of target/, and two passes at once (the background pass still running when `wheel` starts)
+# race on it ("failed to stage ...").
+MATURIN       := PATH="$(abspath $(VENV))/bin:$$PATH" flock build/wheel/maturin.lock \
+  nice $(VENV)/bin/maturin build --release --compatibility manylinux_2_28
+wheel: .venv release
+	rm -rf $(WHEEL_ENGINES) build/wheel/early dist/fmu_beam-*.whl
 	$(MAKE) --no-print-directory win64
-	mkdir -p $(WHEEL_ENGINES)/linux64
-	cp $(WHEEL_DIR)/$(WHEEL_TARGET)/release/deps/libfmu_beam.so $(WHEEL_ENGINES)/linux64/
+	mkdir -p build/wheel $(WHEEL_ENGINES)/linux64
+	cp $(ENGINE) $(WHEEL_ENGINES)/linux64/
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  mkdir -p $(WHEEL_ENGINES)/win64 && cp $(WIN64_ENGINE) $(WHEEL_ENGINES)/win64/; fi
 	$(MATURIN) --out dist
-	rm -rf build/wheel/first
 	$(PY) -m pip install --quiet --no-deps --force-reinstall dist/fmu_beam-*manylinux*.whl
 
 # The win64 wheel (issue 30), not part of `make test` (about 5 more minutes of build): the same
@@ -187,12 +203,12 @@ wheel: .venv
 WIN64_HARNESS := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu-harness.exe
 wheel-win64: wheel
 	@$(WIN64_READY) || { $(WIN64_MISSING); exit 1; }
-	env PATH="/usr/bin:/bin:$(abspath $(VENV))/bin" RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
-	  CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
+	env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER PATH="/usr/bin:/bin:$(abspath $(VENV))/bin" \
+	  RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
 	  nice $(VENV)/bin/maturin build --release --target $(WIN64_TARGET) -Z build-std=std,panic_unwind --out dist
-	env RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
-	  CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc nice /usr/bin/cargo build \
-	  --release -p fmu-harness --bin fmu-harness --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+	env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
+	  CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
+	  nice /usr/bin/cargo build --release -p fmu-harness --bin fmu-harness --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
 
 # The documents generated from the code (issue 16): the scene schema that editors read and the
 # scene reference; fmu-harness/tests/generated_docs.rs fails when the committed ones differ.
@@ -229,26 +245,27 @@ demo: .venv fmus
 # item 6; every stage is CPU-bound, so what counts is that no core idles: `vmstat 10` beside a
 # fresh clone's run read 0 % idle but where one job was left alone):
 # - the Rust tests' compile, which builds the engine, the packager and its command on the way,
-#   starts at once in the background, then the rest of the Linux build (the bench command; log:
-#   build/release.log): in one cargo run the engine's tests compile beside the packager, where
-#   two runs in turn wait on each crate of the chain faer, fmu-beam, fmu-harness (44, 43, 18 s
-#   here, `cargo build --timings`). Meanwhile Python's venv and Debian's packages install side
-#   by side (about two minutes of download and unpacking on a fresh machine, little CPU).
-# - Then the Windows engine (log: build/win64/build.log) and the wheel's first pass (log:
-#   build/wheel/prebuild.log; its own $(WHEEL_DIR), so no cargo lock is shared with the Linux
-#   build), niced, in the background, while `release` and the Rust tests run in front (each
-#   waits for cargo's lock and finds its units built). Run at normal priority, the Windows
-#   engine slowed the Rust tests as much as it saved at the end (980 s against 981).
+#   starts at once in the background (once the linker is there, seconds), then the rest of the
+#   Linux build (the bench command), then the wheel's extension module (a maturin pass that
+#   finds the rest built: see wheel; log: build/release.log): in one cargo run the engine's tests
+#   compile beside the packager, where two runs in turn wait on each crate of the chain faer,
+#   fmu-beam, fmu-harness (44, 43, 18 s here, `cargo build --timings`). Meanwhile Python's venv
+#   and Debian's packages install side by side (about two minutes of download and unpacking on
+#   a fresh machine, little CPU).
+# - Then the Windows engine (log: build/win64/build.log), niced, in the background, while
+#   `release` and the Rust tests run in front (each waits for cargo's lock and finds its units
+#   built). Run at normal priority, it slowed the Rust tests as much as it saved at the end (980 s
+#   against 981).
 # - tests/test_no_leaks.py (1e4 cycles under valgrind, 2-3 min on one core; its own --basetemp,
 #   its output after the rest's), niced in the background as soon as the Linux engine is built,
 #   on a unit of its own that carries that engine only.
 # - The Rust tests under cargo-nextest where it is installed (every test binary side by side;
 #   `cargo test` runs a binary's tests in threads).
 # - The fuzz stage's FMI half (tests/fuzz/fmi_calls.py; issue 45 item 9, shorter than `make
-#   fuzz` alone, bounded in time, output in build/fuzz.log) once the wheel's first pass is done
+#   fuzz` alone, bounded in time, output in build/fuzz.log) once no maturin pass runs
 #   (maturin.lock), at normal priority, beside the end of the Windows engine's build (its last
 #   crates, faer and fmu-beam, compile one at a time: a core idled there for a minute) and the
-#   units' packaging; `wheel` then finds its first pass built.
+#   units' packaging; `wheel` then finds its extension module built.
 # - pytest in two workers (pytest-xdist, a file's tests in one worker: its module fixtures are
 #   built once), then the fuzz stage's Python half (it needs the wheel; build/fuzz-python.log).
 TEST_FUZZ_SECONDS        ?= 60
@@ -256,17 +273,15 @@ TEST_FUZZ_PYTHON_SECONDS ?= 30
 # The exit status a background job of `test` left in the file $(1) (waits up to 30 min for it;
 # 1 when it never came).
 rc_of = for ((i = 0; i < 1800; i++)); do [[ -e $(1) ]] && break; sleep 1; done; cat $(1) 2>/dev/null || echo 1
-test:
-	@mkdir -p build; echo "release: the Rust tests' compile and the Linux build in the background (build/release.log)"; \
-	{ $(CARGO_TEST_BUILD) && cargo build $(LINUX_CRATES); } </dev/null >build/release.log 2>&1 &
+test: $(LINKER)
+	@mkdir -p build/wheel; echo "release: the Rust tests' compile, the Linux build and the wheel's extension module in the background (build/release.log)"; \
+	{ $(CARGO_TEST_BUILD) && cargo build $(LINUX_CRATES) && $(MATURIN) --out build/wheel/early; } </dev/null >build/release.log 2>&1 &
 	$(MAKE) --no-print-directory -j2 -Otarget .venv test-tools
 	@mkdir -p build/win64; \
 	if [[ "$(WIN64)" != 0 ]] && $(WIN64_READY); then \
 	  echo "win64: building the Windows engine in the background (build/win64/build.log)"; \
 	  $(WIN64_BUILD) </dev/null >build/win64/build.log 2>&1 & \
-	fi; \
-	mkdir -p build/wheel; echo "wheel: its first pass in the background, niced (build/wheel/prebuild.log)"; \
-	$(MATURIN) --out build/wheel/prebuild </dev/null >build/wheel/prebuild.log 2>&1 &
+	fi
 	$(MAKE) --no-print-directory release
 	@mkdir -p build/leaks; rm -f build/pytest-leaks.rc build/fuzz.rc; \
 	$(HARNESS) package scenes/cantilever_free_vibration.toml -o build/leaks/cantilever_free_vibration.fmu \
@@ -289,7 +304,7 @@ test:
 	echo "make fuzz:"; cat build/fuzz.log; echo "make fuzz-python:"; cat build/fuzz-python.log; \
 	exit $$(( rest || leaked || fuzzed || pyfuzzed ))
 
-check:
+check: $(LINKER)
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	$(MAKE) test
