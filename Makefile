@@ -13,6 +13,8 @@ PYTHON3 ?= python3
 VENV    := .venv
 PY      := $(VENV)/bin/python
 STAMP   := $(VENV)/.requirements.stamp
+# The linker script (see below, where it is made).
+LINKER  := $(VENV)/bin/cc-glibc-2.28
 
 HARNESS := target/release/fmu-harness
 BENCH   := target/release/fmu-bench
@@ -44,9 +46,10 @@ WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian pa
 .PHONY: .venv tools browser win64-tools test-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies bench-exhaustive bench-scaling example-split example-hinge example-arm example-sweep example-droop clean distclean
 
 # The Python environment: created once, refreshed when requirements.txt changes. (Not created
-# again where it is there: a build may be linking through its zig, below, meanwhile.)
+# again where it is there: a build may be linking through its zig, below, meanwhile. After the
+# linker's two packages, so that two pips never install into it at once under make -j.)
 .venv: $(STAMP)
-$(STAMP): requirements.txt
+$(STAMP): requirements.txt | $(LINKER)
 	[[ -x $(PY) ]] || $(PYTHON3) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet -r requirements.txt
 	touch $@
@@ -61,8 +64,7 @@ $(STAMP): requirements.txt
 # the Linux build: cargo keeps units apart by linker, and the wheel must be linked so. Cargo reads
 # the linker from the environment; the script lives in the venv, whose maturin and ziglang (their
 # versions from requirements.txt, installed first, in seconds) it calls. A plain `cargo build`
-# outside make links with the system's cc, as cargo does by default.
-LINKER := $(VENV)/bin/cc-glibc-2.28
+# outside make links with the system's cc, as cargo does by default (and builds its units apart).
 export CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER := $(abspath $(LINKER))
 $(LINKER): requirements.txt
 	[[ -x $(PY) ]] || $(PYTHON3) -m venv $(VENV)
