@@ -35,8 +35,8 @@ WIN64_DIR      := target/win64
 WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
 WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
 WIN64_TEST_PACKAGES := wine64
-WIN64_BUILD    := env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) \
-  CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
+WIN64_BUILD    := env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc \
+  RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
   nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
 # Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
 WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/dev/null | grep -c 'install ok installed')" == $(words $(WIN64_PACKAGES)) ]]
