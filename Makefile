@@ -35,9 +35,11 @@ WIN64_DIR      := target/win64
 WIN64_ENGINE   := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu_beam.dll
 WIN64_PACKAGES := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64
 WIN64_TEST_PACKAGES := wine64
-WIN64_BUILD    := env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc \
-  RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
-  nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+# The environment of every Windows build (the engine here, the wheel and the command in wheel-win64).
+WIN64_ENV      := env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc \
+  RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc
+WIN64_BUILD    := $(WIN64_ENV) nice /usr/bin/cargo build --release -p fmu-beam --target $(WIN64_TARGET) \
+  -Zbuild-std=std,panic_unwind
 # Exit status 0 when every package of the Windows build is installed (Debian's dpkg).
 WIN64_READY    := [[ "$$(dpkg-query -W -f='$${Status}\n' $(WIN64_PACKAGES) 2>/dev/null | grep -c 'install ok installed')" == $(words $(WIN64_PACKAGES)) ]]
 WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian packages $(WIN64_PACKAGES);\
@@ -45,12 +47,12 @@ WIN64_MISSING  := echo "win64: the Windows toolchain is not installed (Debian pa
 
 .PHONY: .venv tools browser win64-tools test-tools win64 release fmus wheel wheel-win64 docs demo test check fuzz fuzz-python bench bench-peer bench-interleaved bench-accuracy bench-choice bench-studies bench-exhaustive bench-scaling example-split example-hinge example-arm example-sweep example-droop clean distclean
 
-# The Python environment: created once, refreshed when requirements.txt changes. (Not created
-# again where it is there: a build may be linking through its zig, below, meanwhile. After the
-# linker's two packages, so that two pips never install into it at once under make -j.)
+# The Python environment: created with the linker's two packages (below), then completed, and
+# refreshed when requirements.txt changes (after the linker, so that two pips never install into
+# it at once under make -j; never created again where it is there: a build may be linking
+# through its zig meanwhile).
 .venv: $(STAMP)
 $(STAMP): requirements.txt | $(LINKER)
-	[[ -x $(PY) ]] || $(PYTHON3) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet -r requirements.txt
 	touch $@
 
@@ -205,12 +207,9 @@ wheel: .venv release
 WIN64_HARNESS := $(WIN64_DIR)/$(WIN64_TARGET)/release/fmu-harness.exe
 wheel-win64: wheel
 	@$(WIN64_READY) || { $(WIN64_MISSING); exit 1; }
-	env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER PATH="/usr/bin:/bin:$(abspath $(VENV))/bin" \
-	  RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
-	  nice $(VENV)/bin/maturin build --release --target $(WIN64_TARGET) -Z build-std=std,panic_unwind --out dist
-	env -u CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
-	  CARGO_TARGET_DIR=$(WIN64_DIR) CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc \
-	  nice /usr/bin/cargo build --release -p fmu-harness --bin fmu-harness --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
+	$(WIN64_ENV) PATH="/usr/bin:/bin:$(abspath $(VENV))/bin" nice $(VENV)/bin/maturin build --release \
+	  --target $(WIN64_TARGET) -Z build-std=std,panic_unwind --out dist
+	$(WIN64_ENV) nice /usr/bin/cargo build --release -p fmu-harness --bin fmu-harness --target $(WIN64_TARGET) -Zbuild-std=std,panic_unwind
 
 # The documents generated from the code (issue 16): the scene schema that editors read and the
 # scene reference; fmu-harness/tests/generated_docs.rs fails when the committed ones differ.
