@@ -107,7 +107,9 @@ impl Engine {
 
     /// A fingerprint of the scene, so that a state is only restored into the same model.
     fn fingerprint(&self) -> u64 {
-        self.identity
+        *self
+            .identity
+            .get_or_init(|| Engine::identity_of(&self.scene))
     }
 
     /// The fingerprint of a scene: FNV-1a over its canonical text.
