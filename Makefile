@@ -230,12 +230,16 @@ fuzz: .venv release
 # nesting, hostile tolist/items/__str__/__float__/__index__, subclasses with lying methods, huge
 # ints, NaN, bytes, sets, generators) thrown at Scene.from_dict, from_toml, load, package, modes,
 # simulate and the command, seeded and bounded in time (tests/fuzz/python_objects.py, about
-# FUZZ_PYTHON_SECONDS, some 20 cases a second); a crash, a hang or an internal error fails it.
+# FUZZ_PYTHON_SECONDS, some 20 cases a second and worker); a crash, a hang or an internal error
+# fails it. FUZZ_PYTHON_JOBS workers (default: every core) take batches of cases in turn (a
+# case's number and seed reproduce it alone, whatever the number of workers).
 # It uses the fmu_beam installed in .venv (`make wheel`).
 FUZZ_PYTHON_SEED    ?= 45
 FUZZ_PYTHON_SECONDS ?= 60
+FUZZ_PYTHON_JOBS    ?= $(shell nproc)
 fuzz-python: .venv
-	nice $(PY) tests/fuzz/python_objects.py --seed $(FUZZ_PYTHON_SEED) --seconds $(FUZZ_PYTHON_SECONDS)
+	nice $(PY) tests/fuzz/python_objects.py --seed $(FUZZ_PYTHON_SEED) --seconds $(FUZZ_PYTHON_SECONDS) \
+	  --jobs $(FUZZ_PYTHON_JOBS)
 
 # C1's plot, then the C3 and C4 (Ω = 10) animations (HTML player, GIF, a still frame).
 demo: .venv fmus
@@ -269,9 +273,10 @@ demo: .venv fmus
 #   crates, faer and fmu-beam, compile one at a time: a core idled there for a minute) and the
 #   units' packaging; `wheel` then finds its extension module built.
 # - pytest in two workers (pytest-xdist, a file's tests in one worker: its module fixtures are
-#   built once), then the fuzz stage's Python half (it needs the wheel; build/fuzz-python.log).
+#   built once), then the fuzz stage's Python half (it needs the wheel; build/fuzz-python.log)
+#   on both cores for 15 s (one worker for 30 s before: the same CPU time, one core idle).
 TEST_FUZZ_SECONDS        ?= 60
-TEST_FUZZ_PYTHON_SECONDS ?= 30
+TEST_FUZZ_PYTHON_SECONDS ?= 15
 # The exit status a background job of `test` left in the file $(1) (waits up to 30 min for it;
 # 1 when it never came).
 rc_of = for ((i = 0; i < 1800; i++)); do [[ -e $(1) ]] && break; sleep 1; done; cat $(1) 2>/dev/null || echo 1

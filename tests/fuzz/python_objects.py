@@ -32,6 +32,7 @@ import select
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -478,6 +479,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seed", default="45")
     parser.add_argument("--seconds", type=float, default=60.0)
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="workers side by side, each on batches of its own (the cases of a "
+                             "seed are the same for any number)")
     parser.add_argument("--case", type=int, help="run this case alone, and say what it did")
     parser.add_argument("--python", default=sys.executable, help="the interpreter with fmu_beam")
     a = parser.parse_args()
@@ -496,30 +500,53 @@ def main():
             print(results, failure or "")
             sys.exit(1 if failure or any("INTERNAL" in w for _, w in results) else 0)
         deadline = started + a.seconds
-        start = 0
-        while time.monotonic() < deadline:
-            results, failure = run_batch(a.python, a.seed, start, BATCH, arena, deadline)
-            for i, what in results:
-                if "INTERNAL" in what:
-                    internal.append((i, what))
-                kind = "internal error" if "INTERNAL" in what else what
-                counts[kind] += 1
-                example.setdefault(kind, i)
-            if failure:
-                failures.append(failure)
-                done = results[-1][0] + 1 if results else start
-                start = done + 1  # go on after the failed case
-            else:
-                start += len(results) if results else BATCH
-            if failures and len(failures) >= 3:
-                break
+        lock = threading.Lock()
+        # batches to run: (first case, count); a batch that failed part way leaves its rest here
+        rests = []
+        claimed = [0]
+
+        def claim():
+            with lock:
+                if len(failures) >= 3:
+                    return None
+                if rests:
+                    return rests.pop()
+                claimed[0] += BATCH
+                return claimed[0] - BATCH, BATCH
+
+        def work(own_arena):
+            os.makedirs(own_arena, exist_ok=True)
+            while time.monotonic() < deadline and (batch := claim()) is not None:
+                start, count = batch
+                results, failure = run_batch(a.python, a.seed, start, count, own_arena, deadline)
+                with lock:
+                    for i, what in results:
+                        if "INTERNAL" in what:
+                            internal.append((i, what))
+                        kind = "internal error" if "INTERNAL" in what else what
+                        counts[kind] += 1
+                        example.setdefault(kind, i)
+                    if failure:
+                        failures.append(failure)
+                        # go on after the failed case
+                        after = (results[-1][0] + 1 if results else start) + 1
+                        if after < start + count:
+                            rests.append((after, start + count - after))
+
+        # each worker in an arena of its own (the cases write to fixed names in theirs)
+        threads = [threading.Thread(target=work, args=(os.path.join(arena, f"job{k}"),))
+                   for k in range(max(a.jobs, 1))]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
     took = time.monotonic() - started
     total = sum(counts.values())
-    print(f"fuzz-python: seed {a.seed}, {total} cases in {took:.0f} s "
-          f"({total / max(took, 1e-9):.0f} per s)")
+    print(f"fuzz-python: seed {a.seed}, {total} cases in {took:.0f} s on {max(a.jobs, 1)} "
+          f"worker(s) ({total / max(took, 1e-9):.0f} per s)")
     for what, n in counts.most_common():
         print(f"  {n:6d}  {what}  (e.g. case {example[what]})")
-    for i, what in internal:
+    for i, what in sorted(internal):
         print(f"FAILED: case {i}: {what}")
     for f in failures:
         print(f"FAILED: {f}")
