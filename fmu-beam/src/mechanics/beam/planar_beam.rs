@@ -350,13 +350,18 @@ impl PlanarBeam {
         // deformation, with the sums the rotation row needs
         let local = ar.transpose() * gravity.map_or(rdd, |g| rdd - g);
         let (mut a_f, mut f_mff_f, mut mthf_fdd, mut af_fd) = (0.0, 0.0, 0.0, 0.0);
+        // the band's rows as slices (each sum in the order of l, as over the band's entries)
+        let (fs, fds, fdds) = (f.as_slice(), fd.as_slice(), fdd.as_slice());
         for k in 0..nf {
+            let band = self.band[k].clone();
+            let (mff, kff) = (self.mff.row(k, band.clone()), self.kff.row(k, band.clone()));
+            let (f_b, fd_b, fdd_b) = (&fs[band.clone()], &fds[band.clone()], &fdds[band.clone()]);
             let (mut mff_f, mut mff_fdd, mut wt_f, mut kff_f) = (0.0, 0.0, 0.0, 0.0);
-            for l in self.band[k].clone() {
-                mff_f += self.mff[(k, l)] * f[l];
-                mff_fdd += self.mff[(k, l)] * fdd[l];
-                wt_f += self.w[(l, k)] * f[l];
-                kff_f += self.kff[(k, l)] * f[l];
+            for (i, w_lk) in self.w.column(k, band.clone()).enumerate() {
+                mff_f += mff[i] * f_b[i];
+                mff_fdd += mff[i] * fdd_b[i];
+                wt_f += w_lk * f_b[i];
+                kff_f += kff[i] * f_b[i];
             }
             let mthf = self.b[k] + wt_f; // Ī_θf
             a_f += self.a[k] * f[k];
@@ -366,14 +371,13 @@ impl PlanarBeam {
             if qv {
                 let af = self.a[k] + mff_f; // ∫ρ Sᵀū dV
                 af_fd += af * fd[k];
-                let w_fd: f64 = self.band[k].clone().map(|l| self.w[(k, l)] * fd[l]).sum();
+                let w_row = self.w.row(k, band.clone());
+                let w_fd: f64 = w_row.iter().zip(fd_b).map(|(w, x)| w * x).sum();
                 rk -= af * (td * td) + w_fd * (2.0 * td);
             }
             if damping {
-                rk += self.band[k]
-                    .clone()
-                    .map(|l| self.dff[(k, l)] * fd[l])
-                    .sum::<f64>();
+                let dff = self.dff.row(k, band);
+                rk += dff.iter().zip(fd_b).map(|(d, x)| d * x).sum::<f64>();
             }
             r[FLEX + k] += rk;
         }
