@@ -18,6 +18,7 @@ use nalgebra::{DMatrix, DVector, DVectorView, Matrix2, Vector2};
 use std::cell::Cell;
 
 mod build;
+mod energy;
 mod stiffening;
 
 /// Which terms a beam computes (the resolved effects of its scene). A term
@@ -458,12 +459,16 @@ impl PlanarBeam {
         let accel = gravity.map_or(rdd, |g| rdd - g);
         kt[(THETA, THETA)] -= ac.dot(&accel);
         let mut af_fd = 0.0;
+        let (fs, fds, fdds) = (f.as_slice(), fd.as_slice(), fdd.as_slice()); // as in the residual
         for k in 0..nf {
             let (asbar, athsbar) = (ar * col2(&self.sbar, k), ath * col2(&self.sbar, k));
+            let band = self.band[k].clone();
+            let (mff, w) = (self.mff.row(k, band.clone()), self.w.row(k, band.clone()));
+            let (f_b, fdd_b) = (&fs[band.clone()], &fdds[band.clone()]);
             let (mut mff_f, mut w_fdd) = (0.0, 0.0);
-            for l in self.band[k].clone() {
-                mff_f += self.mff[(k, l)] * f[l];
-                w_fdd += self.w[(k, l)] * fdd[l];
+            for ((m, wkl), (x, xdd)) in mff.iter().zip(w).zip(f_b.iter().zip(fdd_b)) {
+                mff_f += m * x;
+                w_fdd += wkl * xdd;
             }
             let af = self.a[k] + mff_f;
             // ∂r_R/∂f, ∂r_R/∂ḟ
@@ -474,9 +479,9 @@ impl PlanarBeam {
             kt[(FLEX + k, THETA)] += d_f_th;
             if qv {
                 let (mut mff_fd, mut w_fd) = (0.0, 0.0);
-                for l in self.band[k].clone() {
-                    mff_fd += self.mff[(k, l)] * fd[l];
-                    w_fd += self.w[(k, l)] * fd[l];
+                for ((m, wkl), xd) in mff.iter().zip(w).zip(&fds[band.clone()]) {
+                    mff_fd += m * xd;
+                    w_fd += wkl * xd;
                 }
                 af_fd += af * fd[k];
                 d_r_f -= asbar * (td * td);
@@ -497,22 +502,27 @@ impl PlanarBeam {
         }
         // ∂r_f/∂f = Wᵀ θ̈ - θ̇² m_ff + K_ff, ∂r_f/∂ḟ = -2θ̇ W + D_ff
         for k in 0..nf {
-            for l in self.band[k].clone() {
-                kt[(FLEX + k, FLEX + l)] += self.w[(l, k)] * tdd + self.kff[(k, l)];
+            let band = self.band[k].clone();
+            let w_col = self.w.column(k, band.clone());
+            for ((l, w_lk), kkl) in band.clone().zip(w_col).zip(self.kff.row(k, band)) {
+                kt[(FLEX + k, FLEX + l)] += w_lk * tdd + kkl;
             }
         }
         if qv {
             for k in 0..nf {
-                for l in self.band[k].clone() {
-                    kt[(FLEX + k, FLEX + l)] -= td * td * self.mff[(k, l)];
-                    ct[(FLEX + k, FLEX + l)] -= 2.0 * td * self.w[(k, l)];
+                let band = self.band[k].clone();
+                let (mff, w) = (self.mff.row(k, band.clone()), self.w.row(k, band.clone()));
+                for ((l, m), wkl) in band.zip(mff).zip(w) {
+                    kt[(FLEX + k, FLEX + l)] -= td * td * m;
+                    ct[(FLEX + k, FLEX + l)] -= 2.0 * td * wkl;
                 }
             }
         }
         if damping {
             for k in 0..nf {
-                for l in self.band[k].clone() {
-                    ct[(FLEX + k, FLEX + l)] += self.dff[(k, l)];
+                let band = self.band[k].clone();
+                for (l, d) in band.clone().zip(self.dff.row(k, band)) {
+                    ct[(FLEX + k, FLEX + l)] += d;
                 }
             }
         }
@@ -522,37 +532,6 @@ impl PlanarBeam {
                 self.stiffening_damping_tangents(&z, &zd, &mut kt, &mut ct);
             }
         }
-    }
-
-    /// Kinetic energy ½ żᵀ M ż (J).
-    pub fn kinetic_energy<'a>(&self, z: impl Coords<'a>, zd: impl Coords<'a>) -> f64 {
-        let n = self.ndof();
-        let mut m = DMatrix::zeros(n, n);
-        self.mass_matrix(z, m.view_mut((0, 0), (n, n)));
-        let zd = zd.into();
-        0.5 * zd.dot(&(&m * zd))
-    }
-
-    /// Strain energy ½ q_fᵀ K_ff q_f (J).
-    pub fn strain_energy<'a>(&self, z: impl Coords<'a>) -> f64 {
-        let z = z.into();
-        let f = z.rows(FLEX, self.nflex());
-        let extra = if self.geometric_stiffening {
-            self.stiffening_energy(&z)
-        } else {
-            0.0
-        };
-        0.5 * f.dot(&self.kff.mul_vec(&f)) + extra
-    }
-
-    /// Potential energy of gravity -g·∫ρ r dV (J).
-    pub fn gravity_energy<'a>(&self, z: impl Coords<'a>, gravity: Option<Vector2<f64>>) -> f64 {
-        let Some(gravity) = gravity else { return 0.0 };
-        let z = z.into();
-        let f = z.rows(FLEX, self.nflex());
-        let (ar, _) = rot(z[THETA]);
-        let com = Vector2::new(z[0], z[1]) * self.mass + ar * self.first_moment(&f);
-        -gravity.dot(&com)
     }
 
     /// World position and angle of a material point map, and their Jacobians over z.
