@@ -136,6 +136,11 @@ def exudyn_args(case, setting):
     return a['ne'], a['step'], a['spectral_radius']
 
 
+def batch(t):
+    """Runs per timed sample for a run of t seconds: enough to last MIN_SAMPLE."""
+    return max(1, math.ceil(MIN_SAMPLE / max(t, 1e-4))) if t < MIN_SAMPLE else 1
+
+
 def run_ours(case, formulation, setting):
     cmd = [FMU_BENCH, 'peer-run', '--scenes', 'scenes', '--references', 'bench/reference',
            '--case', case, '--formulation', formulation, '--setting', setting, '--samples', '1']
@@ -202,8 +207,6 @@ def main():
                               sweep_ratio=o['cpu_median'] / x['cpu_median']))
 
     # the cost of each pair's rounds, from the sweep's medians
-    def batch(t):
-        return max(1, math.ceil(MIN_SAMPLE / max(t, 1e-4))) if t < MIN_SAMPLE else 1
     plan, skipped, estimate = [], [], 0.0
     for key, pr in pairs.items():
         o, x = pr['ours_sweep'], pr['theirs_sweep']

@@ -17,7 +17,6 @@ ours by `fmu-bench peer-run` (thread CPU time, short runs in batches), Exudyn's 
 Prints the table (Markdown) and the load average before and after.
 """
 import argparse
-import math
 import os
 import statistics
 import sys
@@ -25,8 +24,6 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import interleaved  # noqa: E402
-
-MIN_SAMPLE = interleaved.MIN_SAMPLE
 
 # (cells, case, our formulation, our setting, Exudyn's setting as sweep.setting_name writes it)
 PAIRS = [
@@ -55,15 +52,6 @@ PAIRS = [
 ]
 
 
-def theirs_timed(case, setting):
-    """Exudyn's CPU time of one run (a batch averaged where a run is under MIN_SAMPLE)."""
-    cpu, last = interleaved.run_theirs(case, setting, 1)
-    if cpu < MIN_SAMPLE:
-        batch = math.ceil(MIN_SAMPLE / max(cpu, 1e-6))
-        cpu, last = interleaved.run_theirs(case, setting, batch)
-    return cpu, last
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--repeats', type=int, default=5)
@@ -77,9 +65,11 @@ def main():
             continue
         ratios, ours_cpu, theirs_cpu = [], [], []
         ours_err = None
+        # Exudyn's batch sized once, from one untimed run (ours batches itself in peer-run)
+        runs = interleaved.batch(interleaved.run_theirs(case, theirs, 1)[0])
         for _ in range(a.repeats):
             o = interleaved.run_ours(case, formulation, setting)
-            t, _ = theirs_timed(case, theirs)
+            t, _ = interleaved.run_theirs(case, theirs, runs)
             ours_cpu.append(o['cpu'])
             theirs_cpu.append(t)
             ratios.append(o['cpu'] / t)
