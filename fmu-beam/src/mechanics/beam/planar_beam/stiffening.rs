@@ -12,9 +12,59 @@
 //! element's axial stiffness gives), so the force added to β K_ff ḟ is
 //! β EA ℓ (ε̇ ∂ε − u̇' ∂u'), and the damping's power stays −2F ≤ 0.
 
+use std::borrow::Cow;
+
 use super::*;
 
+/// Kept coordinates up to which [`PlanarBeam::add_nodal`] sums on the stack (a frame of 21
+/// elements; beyond, one allocation per call).
+const STACK_NODAL: usize = 64;
+
 impl PlanarBeam {
+    /// The nodal deformation of z (kept coordinates): z's own where they are nodal, computed
+    /// under modal truncation.
+    fn nodal_of<'z>(&self, z: &'z DVectorView<f64>) -> Cow<'z, [f64]> {
+        let f = z.rows(FLEX, self.nflex());
+        match &self.basis {
+            Some(phi) => Cow::Owned((phi * f).as_slice().to_vec()),
+            None => Cow::Borrowed(
+                z.as_slice()
+                    .get(FLEX..FLEX + self.nflex())
+                    .expect("a body's coordinates hold its deformation"),
+            ),
+        }
+    }
+
+    /// Sums the elements' nodal contributions (`fill`) into a zeroed vector and then adds it,
+    /// projected on the modes under truncation, into `out`: the sums of a vector allocated
+    /// per call, in the same order, without the allocation for up to [`STACK_NODAL`] kept
+    /// coordinates.
+    fn add_nodal(&self, out: &mut [f64], fill: impl FnOnce(&mut [f64])) {
+        let nk = self.kept.len();
+        let mut stack = [0.0; STACK_NODAL];
+        let mut heap = Vec::new();
+        let nodal = if nk <= STACK_NODAL {
+            &mut stack[..nk]
+        } else {
+            heap.resize(nk, 0.0);
+            &mut heap[..]
+        };
+        fill(nodal);
+        match &self.basis {
+            Some(phi) => {
+                let projected = phi.tr_mul(&DVectorView::from_slice(nodal, nk));
+                for (o, x) in out.iter_mut().zip(projected.iter()) {
+                    *o += x;
+                }
+            }
+            None => {
+                for (o, x) in out.iter_mut().zip(nodal.iter()) {
+                    *o += x;
+                }
+            }
+        }
+    }
+
     /// Switches geometric stiffening (the nonlinear axial strain) on or off; `options` keeps
     /// the value the beam was built with.
     pub fn set_geometric_stiffening(&mut self, on: bool) {
@@ -27,7 +77,7 @@ impl PlanarBeam {
     #[allow(clippy::type_complexity)]
     pub(super) fn for_element_strains(
         &self,
-        fq: &DVector<f64>,
+        fq: &[f64],
         mut visit: impl FnMut(
             &[Option<usize>; ELEMENT_DOFS],
             f64,
@@ -61,31 +111,25 @@ impl PlanarBeam {
     /// truncation).
     pub(super) fn stiffening_force(&self, z: &DVectorView<f64>, out: &mut [f64]) {
         let ea = self.ea;
-        let fq = self.nodal(z);
-        let mut nodal = DVector::zeros(self.kept.len());
-        self.for_element_strains(&fq, |idx, l, eps, de, _| {
-            let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
-            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
-            for p in 0..ELEMENT_DOFS {
-                if let Some(k) = idx[p] {
-                    nodal[k] += ea * l * (eps * de[p] - du * da[p]);
+        let fq = self.nodal_of(z);
+        self.add_nodal(out, |nodal| {
+            self.for_element_strains(&fq, |idx, l, eps, de, _| {
+                let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
+                let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+                for p in 0..ELEMENT_DOFS {
+                    if let Some(k) = idx[p] {
+                        nodal[k] += ea * l * (eps * de[p] - du * da[p]);
+                    }
                 }
-            }
+            })
         });
-        let projected = match &self.basis {
-            Some(phi) => phi.tr_mul(&nodal),
-            None => nodal,
-        };
-        for (o, x) in out.iter_mut().zip(projected.iter()) {
-            *o += x;
-        }
     }
 
     /// Tangent of [`Self::stiffening_force`]: EA ℓ (∂ε ∂εᵀ + ε ⟨v'_q v'_qᵀ⟩ - ∂u' ∂u'ᵀ),
     /// element by element into `kt` (through the modes under truncation).
     pub(super) fn stiffening_tangent<B: BlockMut>(&self, z: &DVectorView<f64>, kt: &mut B) {
         let ea = self.ea;
-        let fq = self.nodal(z);
+        let fq = self.nodal_of(z);
         let mut nodal = self.basis.as_ref().map(|_| {
             let nk = self.kept.len();
             DMatrix::zeros(nk, nk)
@@ -113,7 +157,7 @@ impl PlanarBeam {
     pub(super) fn stiffening_energy(&self, z: &DVectorView<f64>) -> f64 {
         let mut e = 0.0;
         let ea = self.ea;
-        let fq = self.nodal(z);
+        let fq = self.nodal_of(z);
         self.for_element_strains(&fq, |idx, l, eps, _, _| {
             let du = (idx[3].map_or(0.0, |k| fq[k]) - idx[0].map_or(0.0, |k| fq[k])) / l;
             e += 0.5 * ea * l * (eps * eps - du * du);
@@ -138,7 +182,7 @@ impl PlanarBeam {
             &[[f64; ELEMENT_DOFS]; ELEMENT_DOFS],
         ),
     ) {
-        let (fq, fqd) = (self.nodal(z), self.nodal(zd));
+        let (fq, fqd) = (self.nodal_of(z), self.nodal_of(zd));
         self.for_element_strains(&fq, |idx, l, _, de, hv| {
             let qd: [f64; ELEMENT_DOFS] = std::array::from_fn(|p| idx[p].map_or(0.0, |k| fqd[k]));
             let eps_dot: f64 = (0..ELEMENT_DOFS).map(|p| de[p] * qd[p]).sum();
@@ -158,22 +202,16 @@ impl PlanarBeam {
         out: &mut [f64],
     ) {
         let c = self.rayleigh_beta * self.ea;
-        let mut nodal = DVector::zeros(self.kept.len());
-        self.for_element_strain_rates(z, zd, |idx, l, eps_dot, du_dot, de, _, _| {
-            let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
-            for p in 0..ELEMENT_DOFS {
-                if let Some(k) = idx[p] {
-                    nodal[k] += c * l * (eps_dot * de[p] - du_dot * da[p]);
+        self.add_nodal(out, |nodal| {
+            self.for_element_strain_rates(z, zd, |idx, l, eps_dot, du_dot, de, _, _| {
+                let da = [-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0];
+                for p in 0..ELEMENT_DOFS {
+                    if let Some(k) = idx[p] {
+                        nodal[k] += c * l * (eps_dot * de[p] - du_dot * da[p]);
+                    }
                 }
-            }
+            })
         });
-        let projected = match &self.basis {
-            Some(phi) => phi.tr_mul(&nodal),
-            None => nodal,
-        };
-        for (o, x) in out.iter_mut().zip(projected.iter()) {
-            *o += x;
-        }
     }
 
     /// Tangents of [`Self::stiffening_damping`]: ∂/∂ḟ = β EA ℓ (∂ε ∂εᵀ − ∂u' ∂u'ᵀ) into `ct`,
