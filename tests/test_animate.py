@@ -177,17 +177,25 @@ def test_gif_shows_the_c4_tip_where_the_csv_says(c4):
           f"over {len(gif)} frames")
 
 
+def rod_mid_node(run):
+    """The rod's middle node (its shape outputs count from 1): an even number of elements."""
+    nodes = sum(1 for name in run if name.startswith("rod.shape.x["))
+    assert nodes % 2 == 1, nodes
+    return (nodes + 1) // 2
+
+
 def test_gif_magnifies_the_rod_s_deflection_only(c3):
     meta, run = c3["meta"], c3["run"]
     m = meta["magnification"]
     assert m == 20  # the rod deflects 0.4 % of its length: about 10 % shown
     gif = frames(c3["gif"])
     rod = meta["beam_colors"][1]
+    k_mid = rod_mid_node(run)
     checked = 0
     for k in range(0, len(gif), 8):
         t = meta["times"][k]
         root = np.array([at(run, "rod.shape.x[1]", t), at(run, "rod.shape.y[1]", t)])
-        mid = np.array([at(run, "rod.shape.x[5]", t), at(run, "rod.shape.y[5]", t)])
+        mid = np.array([at(run, f"rod.shape.x[{k_mid}]", t), at(run, f"rod.shape.y[{k_mid}]", t)])
         axis = np.array([at(run, "rod.axis.x", t), at(run, "rod.axis.y", t)])
         d = mid - root
         across = d - (d @ axis) * axis
@@ -215,7 +223,8 @@ def test_page_loads_without_errors_and_the_beam_moves(c3, browser):
     second = browser.eval("window.anim.drawnBeams()")
     browser.page.screenshot(path=ARTIFACTS / "slider_crank_page_t1.2.png")
     assert [b["name"] for b in first] == ["crank", "rod"]
-    moved = np.hypot(*(np.array(first[1]["px"][4]) - np.array(second[1]["px"][4])))
+    mid = rod_mid_node(c3["run"]) - 1  # the drawn points count from 0
+    moved = np.hypot(*(np.array(first[1]["px"][mid]) - np.array(second[1]["px"][mid])))
     assert moved > 20, f"the rod's mid-span moved {moved} px between 0.4 and 1.2 s"
     a = np.asarray(Image.open(ARTIFACTS / "slider_crank_page_t0.4.png").convert("RGB")).astype(int)
     b = np.asarray(Image.open(ARTIFACTS / "slider_crank_page_t1.2.png").convert("RGB")).astype(int)
@@ -224,7 +233,7 @@ def test_page_loads_without_errors_and_the_beam_moves(c3, browser):
     rod = c3["meta"]["beam_colors"][1]
     box = browser.page.locator("#view").bounding_box()
     scale = box["width"] / browser.eval("document.getElementById('view').width")
-    mx, my = (np.array(first[1]["px"][4]) * scale + [box["x"], box["y"]]).round().astype(int)
+    mx, my = (np.array(first[1]["px"][mid]) * scale + [box["x"], box["y"]]).round().astype(int)
     assert np.count_nonzero(colour_mask(a, rod)) > 200
     assert colour_mask(a[my - 2:my + 3, mx - 2:mx + 3], rod).any(), (mx, my)
     assert browser.failures == []

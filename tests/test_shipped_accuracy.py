@@ -20,7 +20,8 @@ REFERENCES = {
     "flexible_pendulum": ("c2", {"beam.tip.y": "tip_y"}),
     "flexible_pendulum_substructured": ("c2", {"beam.tip.y": "tip_y"}),
     "slider_crank": ("c3_elastic", {"slider.position": "slider_position"}),
-    "slider_crank_rigid_crank": ("c3_rigid", {"slider.position": "slider_position"}),
+    "slider_crank_rigid_crank": ("c3_rigid", {"slider.position": "slider_position",
+                                             "rod.mid.deflection": "rod_mid_deflection"}),
     "spin_up_omega10": ("c4_omega10", {"beam.tip.deflection": "tip_deflection"}),
     "spin_up_omega4": ("c4_omega4", {"beam.tip.deflection": "tip_deflection"}),
     # the C4 variants (issue 46 item 2): effects = "auto" on 5 x 1, one stiffened frame

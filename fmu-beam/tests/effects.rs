@@ -67,12 +67,12 @@ fn auto_resolves_the_expected_effects_of_each_validation_scene() {
             "slider_crank.toml",
             &[
                 "gravity(scene)=off",
-                "flexibility(crank)=3 elements",
+                "flexibility(crank)=2 elements",
                 "axial(crank)=on",
                 "quadratic_velocity(crank)=on",
                 "geometric_stiffening(crank)=off",
                 "rayleigh_damping(crank)=off",
-                "flexibility(rod)=8 elements",
+                "flexibility(rod)=4 elements",
                 "axial(rod)=on",
                 "quadratic_velocity(rod)=on",
                 "geometric_stiffening(rod)=on",
@@ -84,7 +84,7 @@ fn auto_resolves_the_expected_effects_of_each_validation_scene() {
             &[
                 "gravity(scene)=off",
                 "flexibility(crank)=rigid",
-                "flexibility(rod)=8 elements",
+                "flexibility(rod)=4 elements",
                 "axial(rod)=on",
                 "quadratic_velocity(rod)=on",
                 "geometric_stiffening(rod)=on",

@@ -29,7 +29,7 @@ const REFERENCES: [(&str, &str, &str); 8] = [
     (
         "slider_crank_rigid_crank",
         "c3_rigid.csv",
-        "slider_position",
+        "rod_mid_deflection",
     ),
     ("spin_up_omega10", "c4_omega10.csv", "tip_deflection"),
     (
