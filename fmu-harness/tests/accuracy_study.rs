@@ -484,7 +484,11 @@ fn a_ladder_out_of_its_asymptotic_range_goes_on_and_the_halved_mesh_is_studied_a
     // the paper's mesh, which the scene shipped with until it took this study's choice
     let mut scene = load(&root.join("scenes/slider_crank.toml"));
     for (beam, elements) in [("crank", 3), ("rod", 8)] {
-        let b = scene.beams.iter_mut().find(|b| b.name == beam).expect("the beam");
+        let b = scene
+            .beams
+            .iter_mut()
+            .find(|b| b.name == beam)
+            .expect("the beam");
         b.elements = Some(elements);
     }
     let s = accuracy::study(&scene, &o).unwrap();
