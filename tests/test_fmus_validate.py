@@ -1,6 +1,8 @@
 """Every packaged FMU is a valid FMI 2.0 co-simulation unit: fmpy's validator finds no problem,
 and fmpy's own master runs it to its DefaultExperiment stop time with finite outputs."""
 
+import zipfile
+
 import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
@@ -23,6 +25,23 @@ def test_there_are_packaged_fmus(fmu_dir):
 @pytest.mark.parametrize("path", FMUS, ids=IDS)
 def test_validate_fmu_finds_no_problem(path):
     assert validate_fmu(str(path)) == []
+
+
+@pytest.mark.parametrize("path", FMUS, ids=IDS)
+def test_the_zip_keeps_to_the_standard_and_stores_the_engines(path):
+    """FMI's rules for the archive (compression 8, deflate, or 0, store; the data-descriptor bit
+    only on deflated entries; version needed to extract at most 2.0; no encryption), and the
+    engines stored: fmpy extracts the whole unit on every simulate_fmu call
+    (fmu-harness/src/archive.rs)."""
+    with zipfile.ZipFile(path) as z:
+        for info in z.infolist():
+            assert info.compress_type in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED), info
+            assert not info.flag_bits & 0x1, info  # encrypted
+            if info.compress_type == zipfile.ZIP_STORED:
+                assert not info.flag_bits & 0x8, info
+            assert info.extract_version <= 20, info
+            binary = info.filename.startswith("binaries/")
+            assert (info.compress_type == zipfile.ZIP_STORED) == binary, info
 
 
 @pytest.mark.parametrize("path", FMUS, ids=IDS)
