@@ -354,7 +354,7 @@ impl IterationMatrix {
     /// imposes) is kept. False when there are no factors or the solution is not finite.
     pub fn filter(&mut self, e: &mut DVector<f64>, rhs: &mut DVector<f64>) -> bool {
         let n = self.n;
-        rhs.fill(0.0);
+        rhs.as_mut_slice().fill(0.0);
         for (r, b) in self.mass.ranges.iter().zip(&self.mass.blocks) {
             let x = &e.as_slice()[r.clone()];
             b.gemv(self.cm, x, 0.0, &mut rhs.as_mut_slice()[r.clone()]);
@@ -380,9 +380,10 @@ impl IterationMatrix {
         match &mut self.factors {
             Factors::Dense { lu, .. } => lu.as_ref().is_some_and(|lu| lu.solve_mut(rhs)),
             Factors::Sparse(s) => {
-                let finite = rhs.iter().all(|x| x.is_finite());
+                // the slice's iterator, not nalgebra's strided one (every Newton iteration)
+                let finite = all_finite(rhs);
                 s.solve_mut(rhs.as_mut_slice());
-                !finite || rhs.iter().all(|x| x.is_finite())
+                !finite || all_finite(rhs)
             }
             Factors::Bordered {
                 band,
@@ -396,11 +397,15 @@ impl IterationMatrix {
                         .and_then(|d| d.1.as_ref())
                         .is_some_and(|lu| lu.solve_mut(rhs));
                 }
-                let finite = rhs.iter().all(|x| x.is_finite());
-                band.solve_mut(rhs.as_mut_slice()) && (!finite || rhs.iter().all(|x| x.is_finite()))
+                let finite = all_finite(rhs);
+                band.solve_mut(rhs.as_mut_slice()) && (!finite || all_finite(rhs))
             }
         }
     }
+}
+
+fn all_finite(x: &DVector<f64>) -> bool {
+    x.as_slice().iter().all(|x| x.is_finite())
 }
 
 /// Writes [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]] into `jac` (zeros elsewhere).
@@ -412,7 +417,7 @@ fn assemble_dense(
     with_tangents: bool,
     n: usize,
 ) {
-    jac.fill(0.0);
+    jac.as_mut_slice().fill(0.0);
     for (b, r) in mass.ranges.iter().enumerate() {
         let (mm, k, c) = (&mass.blocks[b], &kt.blocks[b], &ct.blocks[b]);
         for_each_scaled(mm, k, c, w, with_tangents, |i, j, x| {

@@ -142,12 +142,12 @@ impl Stepper {
     }
 
     /// Weighted RMS norm of a position-like vector against the tolerance.
-    pub(super) fn norm<'a>(&self, dq: impl Iterator<Item = &'a f64>, q: &DVector<f64>) -> f64 {
+    pub(super) fn norm(&self, dq: impl Iterator<Item = f64>, q: &DVector<f64>) -> f64 {
         let tol = self.settings.tolerance;
         let n = q.len().max(1) as f64;
         let s: f64 = dq
-            .zip(q.iter())
-            .zip(self.scale.iter())
+            .zip(q.as_slice())
+            .zip(self.scale.as_slice())
             .map(|((d, x), sc)| {
                 let w = tol * (x.abs() + sc);
                 (d / w) * (d / w)
@@ -167,12 +167,12 @@ impl Stepper {
         c: &Coefficients,
     ) -> f64 {
         let e = self.position_error(st, t1, q1, c);
-        let raw = self.norm(e.iter(), q1);
+        let raw = self.norm(e.iter().copied(), q1);
         if raw <= 1.0 || self.settings.rho_inf >= 1.0 {
             return raw;
         }
         self.filtered(e, q1)
-            .map_or(raw, |f| raw.min(self.norm(f.iter(), q1)))
+            .map_or(raw, |f| raw.min(self.norm(f.iter().copied(), q1)))
     }
 
     /// The position error `e` of a step ending at `q1`, filtered [`FILTER_PASSES`] times by

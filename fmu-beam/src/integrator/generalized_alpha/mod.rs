@@ -71,12 +71,22 @@ impl Clone for GaState {
     fn clone_from(&mut self, o: &GaState) {
         self.t = o.t;
         self.h = o.h;
-        self.q.clone_from(&o.q);
-        self.v.clone_from(&o.v);
-        self.acc.clone_from(&o.acc);
-        self.qdd.clone_from(&o.qdd);
-        self.lambda.clone_from(&o.lambda);
+        copy_vector(&mut self.q, &o.q);
+        copy_vector(&mut self.v, &o.v);
+        copy_vector(&mut self.acc, &o.acc);
+        copy_vector(&mut self.qdd, &o.qdd);
+        copy_vector(&mut self.lambda, &o.lambda);
         self.work = o.work;
+    }
+}
+
+/// Copies `src` into `dst`'s storage where their lengths agree, else clones it: nalgebra's
+/// `clone_from` is its derived default, a new allocation each time.
+pub(crate) fn copy_vector(dst: &mut DVector<f64>, src: &DVector<f64>) {
+    if dst.len() == src.len() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
     }
 }
 
@@ -226,7 +236,7 @@ const TINY: f64 = 1e-6;
 
 /// Where the factorized iteration matrix was evaluated. The factors are not stored: a restored
 /// state factorizes the matrix again at this point, so that it continues bit for bit.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct MatrixPoint {
     pub q: DVector<f64>,
     pub v: DVector<f64>,
@@ -238,7 +248,7 @@ pub struct MatrixPoint {
 
 /// What the integrator carries from one step to the next beyond the state itself (part of the
 /// FMU state): the iteration matrix's point and its measured contraction.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, PartialEq, Default)]
 pub struct Memory {
     pub point: Option<MatrixPoint>,
     pub contraction: Contraction,
@@ -257,6 +267,69 @@ pub struct Memory {
     /// newest (the current state) last, at most [`HISTORY`]: the local error estimate is the
     /// third divided difference of these and the step's end ([`Stepper::attempt`]).
     pub history: Vec<(f64, DVector<f64>)>,
+}
+
+impl Clone for MatrixPoint {
+    fn clone(&self) -> MatrixPoint {
+        MatrixPoint {
+            q: self.q.clone(),
+            v: self.v.clone(),
+            qdd: self.qdd.clone(),
+            lambda: self.lambda.clone(),
+            t: self.t,
+            h: self.h,
+        }
+    }
+
+    /// Copies into the vectors already there.
+    fn clone_from(&mut self, o: &MatrixPoint) {
+        copy_vector(&mut self.q, &o.q);
+        copy_vector(&mut self.v, &o.v);
+        copy_vector(&mut self.qdd, &o.qdd);
+        copy_vector(&mut self.lambda, &o.lambda);
+        self.t = o.t;
+        self.h = o.h;
+    }
+}
+
+impl Clone for Memory {
+    fn clone(&self) -> Memory {
+        Memory {
+            point: self.point.clone(),
+            contraction: self.contraction,
+            grid: self.grid,
+            controller: self.controller.clone(),
+            noise: self.noise,
+            history: self.history.clone(),
+        }
+    }
+
+    /// Copies into the vectors already there (a unit saves its memory at every communication
+    /// step, `Engine::do_step`).
+    fn clone_from(&mut self, o: &Memory) {
+        // every field named: one added later is not forgotten here
+        let Memory {
+            point,
+            contraction,
+            grid,
+            controller: Controller { recent, cap },
+            noise,
+            history,
+        } = o;
+        self.point.clone_from(point);
+        self.contraction = *contraction;
+        self.grid = *grid;
+        self.controller.recent.clone_from(recent);
+        self.controller.cap = *cap;
+        self.noise = *noise;
+        self.history.truncate(history.len());
+        for (mine, theirs) in self.history.iter_mut().zip(history) {
+            mine.0 = theirs.0;
+            copy_vector(&mut mine.1, &theirs.1);
+        }
+        let kept = self.history.len();
+        self.history.extend_from_slice(&history[kept..]);
+    }
 }
 
 /// Why a fixed step was cut short.

@@ -102,12 +102,27 @@ impl Stepper {
                 self.memory.point = Some(p);
             }
         }
-        // predictor: q''_{n+1} = q''_n
+        // predictor: q''_{n+1} = q''_n; element by element, the operations of
+        // a_{n+1} = (α_f q''_n - α_m a_n + (1 - α_f) q''_{n+1}) / (1 - α_m),
+        // v = v_n + h (1 - γ) a_n + h γ a_{n+1}, q = q_n + h v_n + h² (1/2 - β) a_n + d a_{n+1}
+        // in the order the vector expressions took them, without their temporaries
         let mut qdd = st.qdd.clone();
-        let acc_new = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m + &qdd * (1.0 - c.alpha_f))
-            / (1.0 - c.alpha_m);
-        let mut v = &st.v + &st.acc * (h * (1.0 - c.gamma)) + &acc_new * (h * c.gamma);
-        let mut q = &st.q + &st.v * h + &st.acc * (h * h * (0.5 - c.beta)) + &acc_new * d;
+        let mut v = st.v.clone();
+        let mut q = st.q.clone();
+        let (v_acc, v_new) = (h * (1.0 - c.gamma), h * c.gamma);
+        let q_acc = h * h * (0.5 - c.beta);
+        {
+            // slices of one length: no bounds check in the loop
+            let (q0, v0) = (&st.q.as_slice()[..n], &st.v.as_slice()[..n]);
+            let (a0, qdd0) = (&st.acc.as_slice()[..n], &st.qdd.as_slice()[..n]);
+            let (q1, v1) = (&mut q.as_mut_slice()[..n], &mut v.as_mut_slice()[..n]);
+            for i in 0..n {
+                // q''_{n+1} = q''_n here
+                let acc_new = next_acc(&c, qdd0[i], a0[i], qdd0[i]);
+                v1[i] = v0[i] + a0[i] * v_acc + acc_new * v_new;
+                q1[i] = q0[i] + v0[i] * h + a0[i] * q_acc + acc_new * d;
+            }
+        }
         let mut lambda = st.lambda.clone();
         let mut fresh = false;
         let mut prev = f64::INFINITY;
@@ -121,7 +136,10 @@ impl Stepper {
         // Newton's error bound: κ of the tolerance, and at most the tolerance's share of the
         // step's own increment, so that it cannot pile up over many small steps (summed over a
         // run it stays below tol × the path the coordinates travel)
-        let increment = self.norm((&q - &st.q).iter(), &q);
+        let increment = self.norm(
+            q.as_slice().iter().zip(st.q.as_slice()).map(|(a, b)| a - b),
+            &q,
+        );
         let kappa = KAPPA.min(INCREMENT_SHARE * self.settings.tolerance * increment);
         for it in 0..MAX_NEWTON {
             if !self.matrix.is_factored() {
@@ -167,18 +185,26 @@ impl Stepper {
             }
             stats.newton_iterations += 1;
             iterations += 1;
-            let dq = self.rhs.rows(0, n);
-            q += dq;
-            v.axpy(gamma_p, &dq, 1.0);
-            qdd.axpy(beta_p, &dq, 1.0);
-            for k in 0..m {
-                lambda[k] += self.rhs[n + k] / d;
+            // on slices, not through nalgebra's strided iterators (every iteration); the
+            // operations of q += Δq, q' += γ' Δq, q'' += β' Δq
+            let (dq, dl) = self.rhs.as_slice().split_at(n);
+            {
+                let (q1, v1) = (&mut q.as_mut_slice()[..n], &mut v.as_mut_slice()[..n]);
+                let qdd1 = &mut qdd.as_mut_slice()[..n];
+                for i in 0..n {
+                    q1[i] += dq[i];
+                    v1[i] += gamma_p * dq[i];
+                    qdd1[i] += beta_p * dq[i];
+                }
             }
-            if !dq.iter().all(|x| x.is_finite()) || !q.iter().all(|x| x.is_finite()) {
+            for (l, x) in lambda.as_mut_slice().iter_mut().zip(&dl[..m]) {
+                *l += x / d;
+            }
+            if !dq.iter().all(|x| x.is_finite()) || !q.as_slice().iter().all(|x| x.is_finite()) {
                 self.forget();
                 return Err(Failure::NonFinite);
             }
-            norm = self.norm(dq.iter(), &q);
+            norm = self.norm(dq.iter().copied(), &q);
             let ratio = norm / prev;
             let size = norm * tol / f64::EPSILON;
             if fresh
@@ -201,9 +227,11 @@ impl Stepper {
             k += 1;
             match verdict {
                 Verdict::Converged => {
-                    let mut acc = (&st.qdd * c.alpha_f - &st.acc * c.alpha_m
-                        + &qdd * (1.0 - c.alpha_f))
-                        / (1.0 - c.alpha_m);
+                    let mut acc = qdd.clone();
+                    let (a0, qdd0) = (&st.acc.as_slice()[..n], &st.qdd.as_slice()[..n]);
+                    for (i, a) in acc.as_mut_slice()[..n].iter_mut().enumerate() {
+                        *a = next_acc(&c, qdd0[i], a0[i], *a);
+                    }
                     // coordinates of massless bodies are algebraic: their accelerations enter
                     // no equation, and the scheme's recurrence would let them grow without bound
                     for &k in &self.algebraic {
@@ -264,4 +292,10 @@ impl Stepper {
             fresh,
         })
     }
+}
+
+/// The algorithmic acceleration a_{n+1} = (α_f q''_n - α_m a_n + (1 - α_f) q''_{n+1}) / (1 - α_m)
+/// of one coordinate, its operations in the order of the vector expression it replaces.
+fn next_acc(c: &Coefficients, qdd_old: f64, acc_old: f64, qdd_new: f64) -> f64 {
+    (qdd_old * c.alpha_f - acc_old * c.alpha_m + qdd_new * (1.0 - c.alpha_f)) / (1.0 - c.alpha_m)
 }

@@ -35,7 +35,7 @@ impl Block {
 
     pub fn fill_zero(&mut self) {
         match self {
-            Block::Dense(d) => d.fill(0.0),
+            Block::Dense(d) => d.as_mut_slice().fill(0.0),
             Block::Band(b) => b.fill_zero(),
         }
     }

@@ -445,7 +445,7 @@ impl super::equations::Equations for System {
         t: f64,
         r: &mut DVector<f64>,
     ) {
-        r.fill(0.0);
+        r.as_mut_slice().fill(0.0);
         for (i, b) in self.bodies.iter().enumerate() {
             let o = self.offsets[i];
             let n = b.ndof();

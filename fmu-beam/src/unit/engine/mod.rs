@@ -66,9 +66,12 @@ struct Model {
     body_index: Vec<usize>,
     /// The material points of the shape outputs (evaluated only when read).
     shape: crate::unit::shape::ShapeMaps,
+    /// What the last `do_step` saved, kept for its storage: the next one saves into it.
+    spare: Option<ModelState>,
 }
 
-/// The integration state of a built model, as get/set FMU state copy it.
+/// The integration state of a built model, as get/set FMU state copy it (and `do_step` saves
+/// it, into the storage of the last one: `Model::spare`).
 #[derive(Debug, Clone, PartialEq)]
 struct ModelState {
     time: f64,
@@ -515,6 +518,7 @@ impl Engine {
                 stats: Stats::default(),
                 joint_index,
                 body_index,
+                spare: None,
             });
         }
         Ok(self.model.as_mut().expect("model built above"))
@@ -539,7 +543,7 @@ impl Engine {
         // what the master saw at `now`: a failed step gives it back, also where the inputs'
         // change had the integrator land on `now` from past it first
         let m = self.built()?;
-        let saved = m.save();
+        let saved = m.save_reusing();
         // the step in the system's time (from the run's start): exact where the start time and
         // the end are within a factor of 2 (Sterbenz), and never shorter than the time moves
         let (tau_now, tau_end) = (m.state.t, end - m.origin);
@@ -576,6 +580,7 @@ impl Engine {
             }
             Ok(()) => {
                 m.applied_inputs = crate::unit::interface::inputs_ended(&m.system, m.state.t);
+                m.spare = Some(saved);
                 Ok(())
             }
         }

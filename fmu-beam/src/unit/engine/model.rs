@@ -106,6 +106,33 @@ impl Model {
         }
     }
 
+    /// [`Model::save`] into the storage of the last save (`spare`), without allocating where
+    /// the sizes are the same.
+    pub(super) fn save_reusing(&mut self) -> ModelState {
+        let Some(mut s) = self.spare.take() else {
+            return self.save();
+        };
+        let ModelState {
+            time,
+            state,
+            front,
+            back,
+            stats,
+            applied_inputs,
+            applied_loads,
+            memory,
+        } = &mut s;
+        *time = self.time;
+        state.clone_from(&self.state);
+        front.clone_from(&self.front);
+        back.clone_from(&self.back);
+        *stats = self.stats;
+        applied_inputs.clone_from(&self.applied_inputs);
+        applied_loads.clone_from(&self.applied_loads);
+        memory.clone_from(self.stepper.memory());
+        s
+    }
+
     pub(super) fn put_back(&mut self, s: ModelState) {
         self.time = s.time;
         self.state = s.state;
