@@ -312,4 +312,43 @@ mod tests {
         assert_eq!(c.cap, None);
         assert!(c.accepted(h, 1e-6) > 1.0);
     }
+
+    /// The unit saves its memory into the last save's storage at every communication step:
+    /// what it copies there is equal to the memory, whatever was there before (longer or
+    /// shorter history, vectors of another length, a matrix point or none).
+    #[test]
+    fn a_memory_copied_into_another_equals_it() {
+        let v = |n: usize, x: f64| DVector::from_fn(n, |i, _| x + i as f64);
+        let point = |n: usize, x: f64| super::super::MatrixPoint {
+            q: v(n, x),
+            v: v(n, x + 1.0),
+            qdd: v(n, x + 2.0),
+            lambda: v(2, x + 3.0),
+            t: x,
+            h: 1e-3,
+        };
+        let memory = |n: usize, x: f64, kept: usize, with_point: bool| Memory {
+            point: with_point.then(|| point(n, x)),
+            grid: Some((x, kept as u64)),
+            controller: Controller {
+                recent: vec![x; kept],
+                cap: (kept > 1).then_some((x, 3)),
+            },
+            noise: x,
+            history: (0..kept).map(|k| (k as f64, v(n, x + k as f64))).collect(),
+            ..Memory::default()
+        };
+        let sources = [
+            memory(5, 1.0, 3, true),
+            memory(7, 2.0, 1, false),
+            memory(5, 3.0, 0, true),
+        ];
+        for source in &sources {
+            for target in &sources {
+                let mut copy = target.clone();
+                copy.clone_from(source);
+                assert_eq!(&copy, source);
+            }
+        }
+    }
 }
