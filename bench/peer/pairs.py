@@ -33,6 +33,8 @@ PAIRS = [
      'ne=8;h=0.00025;rho_inf=0.9'),
     ('C2 tip deflection 1e-2', 'c2', '10 x 2 substructures', 'fixed step 1.0e-4 s',
      'ne=16;h=0.0001;rho_inf=0.9'),
+    ('C2 tip deflection 1e-3', 'c2', '20 x 2 substructures', 'fixed step 1.0e-5 s',
+     'ne=32;h=1e-05;rho_inf=0.9'),
     ('C3 elastic slider 1e-4', 'c3_elastic', 'crank 2, rod 4', 'fixed step 2.0e-3 s',
      'ne_rod=4,ne_crank=2;h=0.002;rho_inf=0.9'),
     ('C3 elastic rod mid-span 1e-2', 'c3_elastic', 'crank 3, rod 8', 'fixed step 2.0e-3 s',
