@@ -82,7 +82,7 @@ impl Clone for GaState {
 
 /// Copies `src` into `dst`'s storage where their lengths agree, else clones it: nalgebra's
 /// `clone_from` is its derived default, a new allocation each time.
-pub(crate) fn copy_vector(dst: &mut DVector<f64>, src: &DVector<f64>) {
+fn copy_vector(dst: &mut DVector<f64>, src: &DVector<f64>) {
     if dst.len() == src.len() {
         dst.copy_from(src);
     } else {
