@@ -20,8 +20,8 @@ impl Engine {
         let t = m.time;
         let beams = beam_states(m);
         for (g, beam) in beams.iter().enumerate() {
-            let frames = beam.frames.iter().map(|(n, l, d)| (n.as_str(), *l, *d));
-            let head = (beam.name.as_str(), beam.length, beam.chord.norm());
+            let frames = beam.frames.iter().copied();
+            let head = (beam.name, beam.length, beam.chord.norm());
             check_beam(head, frames, t, &mut self.warned[g], &mut self.messages)?;
         }
         // the chords of a good state, for the spin a diagnosis reads
@@ -30,20 +30,21 @@ impl Engine {
     }
 }
 
-/// A beam at one state, as the validity monitor and the diagnosis of a failed step read it.
-pub(super) struct BeamState {
+/// A beam at one state, as the validity monitor and the diagnosis of a failed step read it;
+/// its names borrowed from the model (the monitor runs at every communication point).
+pub(super) struct BeamState<'m> {
     /// The beam's name in the scene.
-    pub name: String,
+    pub name: &'m str,
     /// Its length (m).
     pub length: f64,
     /// From root to tip, world axes (m; z = 0 in a planar scene).
     pub chord: Vector3<f64>,
     /// Each floating frame: name, length (m), largest transverse deflection (m).
-    pub frames: Vec<(String, f64, f64)>,
+    pub frames: Vec<(&'m str, f64, f64)>,
 }
 
 /// Every beam of the model at its current communication point, in the system's order.
-pub(super) fn beam_states(m: &Model) -> Vec<BeamState> {
+pub(super) fn beam_states(m: &Model) -> Vec<BeamState<'_>> {
     let q = &m.state.q;
     match &m.system {
         Mechanics::Planar(sys) => sys
@@ -56,10 +57,10 @@ pub(super) fn beam_states(m: &Model) -> Vec<BeamState> {
                 let frames = grp.bodies.clone().filter_map(|body| {
                     let b = sys.beam(body)?;
                     let defl = b.largest_transverse(sys.body_coords(body, q));
-                    Some((b.name.clone(), b.length, defl))
+                    Some((b.name.as_str(), b.length, defl))
                 });
                 BeamState {
-                    name: grp.name.clone(),
+                    name: grp.name.as_str(),
                     length: grp.length,
                     chord: Vector3::new(tip[0] - z0[0], tip[1] - z0[1], 0.0),
                     frames: frames.collect(),
@@ -77,10 +78,10 @@ pub(super) fn beam_states(m: &Model) -> Vec<BeamState> {
                     };
                     let z = sys.body_coords(body, q);
                     let defl = b.largest_transverse(z.rows(7, b.nflex()));
-                    Some((b.name.clone(), b.length, defl))
+                    Some((b.name.as_str(), b.length, defl))
                 });
                 BeamState {
-                    name: grp.name.clone(),
+                    name: grp.name.as_str(),
                     length: grp.length,
                     chord: sys.frame_pose(tip, q).0 - sys.frame_pose(root, q).0,
                     frames: frames.collect(),
