@@ -1,7 +1,7 @@
 """The peer's work-precision sweep: Exudyn (2D ANCF cable, generalized-alpha) against the
 references in bench/reference/.
 
-    python bench/peer/sweep.py [--quick]
+    python bench/peer/sweep.py [--quick] [--cases c3_elastic,c3_rigid]
 
 For each case, a grid of element counts, fixed steps and spectral radii; each setting is run
 REPEATS times (once if a run takes more than LONG_RUN s) and timed (CPU seconds of the solve
@@ -10,7 +10,8 @@ alone). Error per output = max over the output grid of |y - y_ref| / max |y_ref|
 Writes build/bench/peer_points.csv
     case,output,tool,formulation,setting,error,cpu_median,cpu_min,cpu_max,steps
 and build/bench/peer_cheapest.csv (cheapest setting by median CPU per case, output, target),
-and prints both tables.
+and prints both tables. `--cases` sweeps those cases only and keeps the other cases' points of
+the existing peer_points.csv (the cheapest table then covers the swept cases).
 """
 import csv
 import os
@@ -41,13 +42,19 @@ FORMULATION = 'ANCF2D cable, generalized-alpha index 3'
 GRID = {
     # the tip deflection's 1e-3 is decided below 5e-5 s (the phase of its 260-430 Hz modes),
     # as our steps go to 1e-5 s
-    'c2': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5), (0.9,)),
-           ((16, 32), (2.5e-5, 1e-5), (0.9,)),
+    # (and the meshes between the doublings, 6, 12 and 24, since 2026-12-07, as ours)
+    'c2': [((2, 4, 6, 8, 12, 16, 24, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5),
+            (0.9,)),
+           ((16, 24, 32), (2.5e-5, 1e-5), (0.9,)),
            ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
-    'c3_elastic': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
+    # and the rods between the doublings (3, 5, 6; the crank of half as many), where C3's
+    # targets are decided (since 2026-12-07, ours too: bench/src/work_precision/peer.rs)
+    'c3_elastic': [((2, 3, 4, 5, 6, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
+                    (0.9,)),
                    ((4, 8, 16), (5e-5, 2.5e-5), (0.9,)),
                    ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
-    'c3_rigid': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4), (0.9,)),
+    'c3_rigid': [((2, 3, 4, 5, 6, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
+                  (0.9,)),
                  ((4, 8, 16), (5e-5, 2.5e-5), (0.9,))],
     'c4_omega10': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                    ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
@@ -96,9 +103,29 @@ def measure(case, ne, h, rho):
     return res, cpus, steps
 
 
-def main(quick=False):
+def read_points(path):
+    """The rows of an earlier peer_points.csv (numbers as numbers)."""
+    with open(path, newline='') as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        for c in ('error', 'cpu_median', 'cpu_min', 'cpu_max'):
+            r[c] = float(r[c])
+    return rows
+
+
+def main(quick=False, cases=None):
     grid = QUICK if quick else GRID
+    if cases:
+        unknown = [c for c in cases if c not in grid]
+        if unknown:
+            sys.exit('unknown cases %s (known: %s)' % (', '.join(unknown), ', '.join(grid)))
+        grid = {c: grid[c] for c in cases}
     os.makedirs(OUT_DIR, exist_ok=True)
+    # the other cases' points are kept: read before the new ones are written
+    kept = []
+    points = os.path.join(OUT_DIR, 'peer_points.csv')
+    if cases and os.path.exists(points):
+        kept = [r for r in read_points(points) if r['case'] not in grid]
     rows = []
     wall0 = time.time()
     for case, blocks in grid.items():
@@ -133,10 +160,10 @@ def main(quick=False):
     wall = time.time() - wall0
     cols = ['case', 'output', 'tool', 'formulation', 'setting', 'error', 'cpu_median', 'cpu_min',
             'cpu_max', 'steps']
-    with open(os.path.join(OUT_DIR, 'peer_points.csv'), 'w', newline='') as f:
+    with open(points, 'w', newline='') as f:
         w = csv.writer(f)
         w.writerow(cols)
-        for r in rows:
+        for r in kept + rows:
             w.writerow([r[c] if not isinstance(r[c], float) else '%.6g' % r[c] for c in cols])
     # cheapest setting meeting each target
     cheapest = []
@@ -167,4 +194,9 @@ def main(quick=False):
 
 
 if __name__ == '__main__':
-    main(quick='--quick' in sys.argv)
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--quick', action='store_true')
+    ap.add_argument('--cases', default='', help='only these cases, comma-separated')
+    a = ap.parse_args()
+    main(quick=a.quick, cases=[c for c in a.cases.split(',') if c])

@@ -120,6 +120,15 @@ pub fn cases() -> Vec<PeerCase> {
                     &[Elements("beam", 4), Pinned("beam")],
                 ),
                 formulation("3 x 2 substructures", &[Substructures("beam", 3, 2)]),
+                // between the doublings, as the peer's 6, 12 and 24 elements
+                // (bench/peer/sweep.py; 2026-12-07)
+                formulation(
+                    "single frame, 8 elements",
+                    &[Elements("beam", 8), Pinned("beam")],
+                ),
+                formulation("6 x 2 substructures", &[Substructures("beam", 6, 2)]),
+                formulation("8 x 2 substructures", &[Substructures("beam", 8, 2)]),
+                formulation("15 x 2 substructures", &[Substructures("beam", 15, 2)]),
                 // the peer's cheapest at 1e-2 and 1e-3 is 2 elements
                 formulation(
                     "single frame, 2 elements",
@@ -179,6 +188,22 @@ pub fn cases() -> Vec<PeerCase> {
                     "crank 1, rod 2",
                     &[Elements("crank", 1), Elements("rod", 2)],
                 ),
+                // the meshes between the doublings, as the peer's rods of 3, 5 and 6 elements
+                // with its crank of half as many (bench/peer/sweep.py): C3's targets fall
+                // between the doublings (crank 2, rod 4 stops at 1.04e-2 of the rod's
+                // mid-span as the step shrinks; crank 2, rod 5 stays within 7.7e-3)
+                formulation(
+                    "crank 1, rod 3",
+                    &[Elements("crank", 1), Elements("rod", 3)],
+                ),
+                formulation(
+                    "crank 2, rod 5",
+                    &[Elements("crank", 2), Elements("rod", 5)],
+                ),
+                formulation(
+                    "crank 3, rod 6",
+                    &[Elements("crank", 3), Elements("rod", 6)],
+                ),
             ],
             settings: c3_settings.clone(),
             least_budget: 0.0,
@@ -198,6 +223,11 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("rod 8", &[Elements("rod", 8)]),
                 formulation("rod 16", &[Elements("rod", 16)]),
                 formulation("rod 2", &[Elements("rod", 2)]),
+                // between the doublings, as the peer's (bench/peer/sweep.py): rod 2 stops at
+                // 1.04e-4 of the slider's travel as the step shrinks, rod 6 within 9.4e-6
+                formulation("rod 3", &[Elements("rod", 3)]),
+                formulation("rod 5", &[Elements("rod", 5)]),
+                formulation("rod 6", &[Elements("rod", 6)]),
             ],
             settings: c3_settings,
             least_budget: 0.0,
@@ -235,6 +265,10 @@ pub fn cases() -> Vec<PeerCase> {
                 formulation("20 x 1 substructures", &[Substructures("beam", 20, 1)]),
                 formulation("30 x 1 substructures", &[Substructures("beam", 30, 1)]),
                 formulation("40 x 1 substructures", &[Substructures("beam", 40, 1)]),
+                // two elements a substructure: 15 x 2 reaches 1e-5 at 1e-3 s (3.4e-6; 8.3e-6 at
+                // 5e-4 s) with half the joints of 30 x 1 (2026-12-07); 12 x 2 stops near 1.2e-5,
+                // 20 x 2 costs more than 30 x 1
+                formulation("15 x 2 substructures", &[Substructures("beam", 15, 2)]),
             ],
             settings: c4_settings,
             least_budget: 0.0,
