@@ -330,7 +330,7 @@ bench: .venv release
 # Against the peer (issue 12): Exudyn (PyPI, its own venv .venv-bench) runs C2-C4 over elements
 # and steps (bench/peer/sweep.py; C2 and C3 4 min each with the meshes between the doublings,
 # 2026-12-07), then this engine over substructures/elements and steps or tolerances
-# (fmu-bench peer; C2 5 min, C3 and C4 Ω = 4 5 min, since C2 may take 20 s a run), both scored
+# (fmu-bench peer; C2 5 min, C3 with C4 Ω = 4 another 5; C2 may take 20 s a run), both scored
 # against the exact references of bench/reference; build/bench/PEER.md has the CPU time ratios
 # at equal accuracy. Then the shipped C2-C4 scenes as a user runs them (issue 34 item 3: their
 # FMUs in fmpy with their own settings, interleaved with Exudyn's cheapest run as accurate;

@@ -42,8 +42,9 @@ PAIRS = [
      'ne=32;h=1e-05;rho_inf=0.9'),
     ('C3 elastic slider 1e-4', 'c3_elastic', 'crank 1, rod 3', 'fixed step 2.0e-3 s',
      'ne_rod=3,ne_crank=1;h=0.002;rho_inf=0.9'),
-    # the peer's crank 2, rod 4 at 2e-3 s: as accurate for good (8.8e-3), and cheaper than the
-    # rod of 5 that the sweep's medians chose (0.073 against 0.052 s there, a noisy run)
+    # the peer's crank 2, rod 4 at 2e-3 s: as accurate for good (8.8e-3) and cheaper than the
+    # rod of 5 that the sweep chose on noisy medians (the rod of 4 0.073 s there, the rod of 5
+    # 0.052 s; here the rod of 4 takes 0.045 s)
     ('C3 elastic rod mid-span 1e-2', 'c3_elastic', 'crank 2, rod 5', 'fixed step 2.0e-3 s',
      'ne_rod=4,ne_crank=2;h=0.002;rho_inf=0.9'),
     ('C3 rigid slider 1e-2, 1e-3', 'c3_rigid', 'rod 2', 'fixed step 1.0e-2 s',
