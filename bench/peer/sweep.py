@@ -48,19 +48,21 @@ GRID = {
            ((16, 24, 32), (2.5e-5, 1e-5), (0.9,)),
            ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
     # and the rods between the doublings (3, 5, 6; the crank of half as many), where C3's
-    # targets are decided (since 2026-12-07, ours too: bench/src/work_precision/peer.rs)
-    'c3_elastic': [((2, 3, 4, 5, 6, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
+    # targets are decided (since 2026-12-07, ours too: bench/src/work_precision/peer.rs);
+    # C3 and C4 from 2e-2 s (since 2026-12-07 evening; ours from 2e-2 s on both), where the
+    # rods of 2 meet 1e-2
+    'c3_elastic': [((2, 3, 4, 5, 6, 8, 16, 32), (2e-2, 1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
                     (0.9,)),
                    ((4, 8, 16), (5e-5, 2.5e-5), (0.9,)),
                    ((4, 8, 16), (1e-3, 2.5e-4), (0.6,))],
-    'c3_rigid': [((2, 3, 4, 5, 6, 8, 16, 32), (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
+    'c3_rigid': [((2, 3, 4, 5, 6, 8, 16, 32), (2e-2, 1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4),
                   (0.9,)),
                  ((4, 8, 16), (5e-5, 2.5e-5), (0.9,))],
-    'c4_omega10': [((2, 4, 8, 16, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
+    'c4_omega10': [((2, 4, 8, 16, 32), (2e-2, 1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                    ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
     # the meshes between the doublings (12, 24) where the 1e-5 target is decided, as our
     # substructure counts 15 and 30 (bench/src/work_precision/peer.rs)
-    'c4_omega4': [((2, 4, 8, 12, 16, 24, 32), (1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
+    'c4_omega4': [((2, 4, 8, 12, 16, 24, 32), (2e-2, 1e-2, 5e-3, 2.5e-3, 1e-3), (0.9,)),
                   ((4, 8, 16), (1e-2, 2.5e-3), (0.6,))],
 }
 QUICK = {k: [((4, 8), (v[0][1][0],), (0.9,))] for k, v in GRID.items()}
