@@ -195,9 +195,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--repeats', type=int, default=5, help='rounds per pair (default 5)')
     ap.add_argument('--long', type=float, default=8.0,
-                    help='a pair whose round takes longer (s, from the sweep) gets 3 rounds')
+                    help='a group of runs whose round takes longer (s, from the sweep) gets 3 '
+                         'rounds')
     ap.add_argument('--skip', type=float, default=40.0,
-                    help='a pair whose round takes longer (s, from the sweep) is left out')
+                    help='a group whose round takes longer (s, from the sweep) is timed on its '
+                         'cheapest runs alone, and left out if that still does')
     ap.add_argument('--cells', default='', help='only these cases, comma-separated')
     ap.add_argument('--margin', type=float, default=1.25,
                     help='candidates: runs meeting the target within this factor of the '
