@@ -62,11 +62,9 @@ SUBPROCESS_OVERHEAD = 0.05   # s per call of ours beyond its runs (start, scene,
 
 
 def read_points(path):
-    with open(path, newline='') as f:
-        rows = list(csv.DictReader(f))
+    """A points CSV (ours or the peer's: the same columns) as sweep.py reads it, steps as int."""
+    rows = sweep.read_points(path)
     for r in rows:
-        r['error'] = float(r['error'])
-        r['cpu_median'] = float(r['cpu_median'])
         r['steps'] = int(float(r['steps'])) if r['steps'] not in ('', None) else 0
     return rows
 
@@ -121,11 +119,6 @@ def meeting(points, tool, case, output, target):
     runs = [p for p in points if p['tool'] == tool and p['case'] == case
             and p['output'] == output and meets(points, p, target)]
     return sorted(runs, key=lambda p: p['cpu_median'])
-
-
-def cheapest(points, tool, case, output, target):
-    runs = meeting(points, tool, case, output, target)
-    return runs[0] if runs else None
 
 
 def candidates(points, tool, case, output, target, margin, most):
