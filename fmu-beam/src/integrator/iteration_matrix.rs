@@ -418,8 +418,31 @@ fn assemble_dense(
     n: usize,
 ) {
     jac.as_mut_slice().fill(0.0);
+    let dim = jac.nrows();
     for (b, r) in mass.ranges.iter().enumerate() {
         let (mm, k, c) = (&mass.blocks[b], &kt.blocks[b], &ct.blocks[b]);
+        if let (Block::Dense(mm), Block::Dense(k), Block::Dense(c)) = (mm, k, c) {
+            // column by column on slices (the operations of for_each_scaled, in its order)
+            let nb = mm.nrows();
+            let out = jac.as_mut_slice();
+            for j in 0..nb {
+                let at = (r.start + j) * dim + r.start;
+                let col = &mut out[at..at + nb];
+                let m_col = &mm.as_slice()[j * nb..(j + 1) * nb];
+                if with_tangents {
+                    let k_col = &k.as_slice()[j * nb..(j + 1) * nb];
+                    let c_col = &c.as_slice()[j * nb..(j + 1) * nb];
+                    for (i, x) in col.iter_mut().enumerate() {
+                        *x = k_col[i] * w.d + m_col[i] * w.cm + c_col[i] * w.cc;
+                    }
+                } else {
+                    for (x, m) in col.iter_mut().zip(m_col) {
+                        *x = m * w.cm;
+                    }
+                }
+            }
+            continue;
+        }
         for_each_scaled(mm, k, c, w, with_tangents, |i, j, x| {
             jac[(r.start + i, r.start + j)] = x
         });
