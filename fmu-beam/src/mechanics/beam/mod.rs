@@ -7,6 +7,7 @@ pub(crate) mod band;
 pub(crate) mod planar_beam;
 pub(crate) mod planar_element;
 pub(crate) mod section;
+pub(crate) mod sines;
 pub(crate) mod spatial_beam;
 pub(crate) mod spatial_element;
 pub(crate) mod spatial_section;
