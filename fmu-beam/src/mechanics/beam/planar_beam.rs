@@ -13,7 +13,7 @@
 use super::band::{Banded, BlockMut};
 use super::planar_element::{self, ELEMENT_DOFS, GAUSS_4};
 use super::section::Section;
-use super::sines::sin_cos;
+use super::sines::RecentTurn;
 use super::FloatingFrame;
 use nalgebra::{DMatrix, DVector, DVectorView, Matrix2, Vector2};
 use std::cell::Cell;
@@ -90,7 +90,11 @@ pub const FLEX: usize = 3;
 
 /// Rotation matrix A(θ) and its derivative A_θ.
 pub fn rot(theta: f64) -> (Matrix2<f64>, Matrix2<f64>) {
-    let (s, c) = sin_cos(theta);
+    rot_of(theta.sin_cos())
+}
+
+/// [`rot`] from the angle's sine and cosine.
+pub fn rot_of((s, c): (f64, f64)) -> (Matrix2<f64>, Matrix2<f64>) {
     (Matrix2::new(c, -s, s, c), Matrix2::new(-s, -c, c, -s))
 }
 
@@ -186,6 +190,8 @@ pub struct PlanarBeam {
     pub basis: Option<DMatrix<f64>>,
     /// Evaluations of the optional terms.
     pub counts: TermCounts,
+    /// Its last angle's sine and cosine ([`RecentTurn`]).
+    pub turn: RecentTurn,
     /// Per deformation coordinate k, the columns l where m_ff, W (either way), K_ff or D_ff
     /// have a nonzero entry: the element matrices are assembled into a band, so the products
     /// of each evaluation skip the zeros (bit for bit the same sums).
@@ -280,7 +286,7 @@ impl PlanarBeam {
         let z = z.into();
         let nf = self.nflex();
         let f = z.rows(FLEX, nf);
-        let (ar, ath) = rot(z[THETA]);
+        let (ar, ath) = self.turn.rot(z[THETA]);
         let c = self.first_moment(&f);
         let athc = ath * c;
         m.set_zero();
@@ -332,7 +338,7 @@ impl PlanarBeam {
         let f = z.rows(FLEX, nf);
         let fd = zd.rows(FLEX, nf);
         let fdd = zdd.rows(FLEX, nf);
-        let (ar, ath) = rot(z[THETA]);
+        let (ar, ath) = self.turn.rot(z[THETA]);
         let (td, tdd) = (zd[THETA], zdd[THETA]);
         let rdd = Vector2::new(zdd[0], zdd[1]);
         let c = self.first_moment(&f);
@@ -435,7 +441,7 @@ impl PlanarBeam {
         let f = z.rows(FLEX, nf);
         let fd = zd.rows(FLEX, nf);
         let fdd = zdd.rows(FLEX, nf);
-        let (ar, ath) = rot(z[THETA]);
+        let (ar, ath) = self.turn.rot(z[THETA]);
         let (td, tdd) = (zd[THETA], zdd[THETA]);
         let rdd = Vector2::new(zdd[0], zdd[1]);
         let c = self.first_moment(&f);
@@ -539,7 +545,7 @@ impl PlanarBeam {
     pub fn point<'a>(&self, map: &PointMap, z: impl Coords<'a>) -> (Vector2<f64>, f64) {
         let z = z.into();
         let f = z.rows(FLEX, self.nflex());
-        let (ar, _) = rot(z[THETA]);
+        let (ar, _) = self.turn.rot(z[THETA]);
         let s = map.s0 + map.displacement(&f);
         (
             Vector2::new(z[0], z[1]) + ar * s,

@@ -39,6 +39,7 @@ impl System {
                         ("b".into(), Vector2::new(spec.length, 0.0)),
                     ],
                     counts: Default::default(),
+                    turn: Default::default(),
                 }));
             } else {
                 let ls = spec.length / k as f64;
@@ -89,6 +90,7 @@ impl System {
                     .map(|(n, p)| (n.clone(), Vector2::new(p.0[0], p.0[1])))
                     .collect(),
                 counts: Default::default(),
+                turn: Default::default(),
             }));
         }
         let mut offsets = Vec::with_capacity(bodies.len());

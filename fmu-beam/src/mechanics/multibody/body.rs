@@ -2,7 +2,8 @@
 //! floating-frame kinematics r = R + A(θ) (s0 + S_p q_f); a rigid body has no q_f.
 
 use super::rigid_body::RigidBody;
-use crate::mechanics::beam::planar_beam::{rot, PlanarBeam, PointMap, TermCounts, FLEX, THETA};
+use crate::mechanics::beam::planar_beam::{PlanarBeam, PointMap, TermCounts, FLEX, THETA};
+use crate::mechanics::beam::sines::RecentTurn;
 use nalgebra::{DMatrixViewMut, DVectorView, Matrix2, Vector2};
 
 #[derive(Debug, Clone)]
@@ -39,6 +40,14 @@ impl Body {
                 .iter()
                 .map(|(_, p)| p.norm())
                 .fold(r.com.norm(), f64::max),
+        }
+    }
+
+    /// Its last angle's sine and cosine.
+    pub fn turn(&self) -> &RecentTurn {
+        match self {
+            Body::Beam(b) => &b.turn,
+            Body::Rigid(r) => &r.turn,
         }
     }
 
@@ -128,7 +137,7 @@ impl Body {
 
     /// World position and angle of a material point.
     pub fn point(&self, map: &PointMap, z: DVectorView<f64>) -> (Vector2<f64>, f64) {
-        let (ar, _) = rot(z[THETA]);
+        let (ar, _) = self.turn().rot(z[THETA]);
         self.placed(map, z, &ar, self.local_point(map, z))
     }
 

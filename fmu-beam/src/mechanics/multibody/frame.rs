@@ -6,7 +6,7 @@
 
 use super::body::Body;
 use crate::mechanics::beam::band::BlockMut;
-use crate::mechanics::beam::planar_beam::{rot, PointMap, FLEX, THETA};
+use crate::mechanics::beam::planar_beam::{PointMap, FLEX, THETA};
 use nalgebra::{DVectorView, Matrix2, Vector2};
 
 /// Where a frame sits.
@@ -58,7 +58,7 @@ impl<'a> FrameState<'a> {
         zd: Option<DVectorView<f64>>,
     ) -> FrameState<'a> {
         let nf = body.nflex();
-        let (ar, ath) = rot(z[THETA]);
+        let (ar, ath) = body.turn().rot(z[THETA]);
         let s = body.local_point(map, z);
         let aths = ath * s;
         let (p, phi) = body.placed(map, z, &ar, s);
@@ -123,7 +123,7 @@ pub fn add_force_tangent<B: BlockMut>(
     k: &mut B,
 ) {
     let nf = body.nflex();
-    let (ar, ath) = rot(z[THETA]);
+    let (ar, ath) = body.turn().rot(z[THETA]);
     let s = body.local_point(map, z);
     k[(THETA, THETA)] += -force.dot(&(ar * s));
     let local = ath.tr_mul(&force);

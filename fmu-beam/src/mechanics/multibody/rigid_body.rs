@@ -2,7 +2,8 @@
 //! c̄ in that frame. A body of zero mass is allowed when joints fix all its coordinates
 //! (the massless slider of case C3): its block of the mass matrix is zero.
 
-use crate::mechanics::beam::planar_beam::{rot, PointMap, TermCounts};
+use crate::mechanics::beam::planar_beam::{PointMap, TermCounts};
+use crate::mechanics::beam::sines::RecentTurn;
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, DVectorView, Vector2};
 
 #[derive(Debug, Clone)]
@@ -17,6 +18,8 @@ pub struct RigidBody {
     pub frames: Vec<(String, Vector2<f64>)>,
     /// Evaluations of the optional terms (gravity only, for a rigid body).
     pub counts: TermCounts,
+    /// Its last angle's sine and cosine ([`RecentTurn`]).
+    pub turn: RecentTurn,
 }
 
 impl RigidBody {
@@ -40,7 +43,7 @@ impl RigidBody {
 
     /// M(z) = [[m I, m A_φ c̄], [·, J_c + m |c̄|²]].
     pub fn mass_matrix(&self, z: DVectorView<f64>, mut m: DMatrixViewMut<f64>) {
-        let (_, ath) = rot(z[2]);
+        let (_, ath) = self.turn.rot(z[2]);
         let mc = ath * self.com * self.mass;
         m.fill(0.0);
         m[(0, 0)] = self.mass;
@@ -61,7 +64,7 @@ impl RigidBody {
         gravity: Option<Vector2<f64>>,
         r: &mut [f64],
     ) {
-        let (ar, ath) = rot(z[2]);
+        let (ar, ath) = self.turn.rot(z[2]);
         let (pd, pdd) = (zd[2], zdd[2]);
         let c = self.com * self.mass;
         let mut rr = Vector2::new(zdd[0], zdd[1]) * self.mass + ath * c * pdd - ar * c * (pd * pd);
@@ -86,7 +89,7 @@ impl RigidBody {
         mut kt: DMatrixViewMut<f64>,
         mut ct: DMatrixViewMut<f64>,
     ) {
-        let (ar, ath) = rot(z[2]);
+        let (ar, ath) = self.turn.rot(z[2]);
         let (pd, pdd) = (zd[2], zdd[2]);
         let mut accel = Vector2::new(zdd[0], zdd[1]);
         if let Some(g) = gravity {
@@ -111,7 +114,7 @@ impl RigidBody {
 
     pub fn gravity_energy(&self, z: DVectorView<f64>, g: Option<Vector2<f64>>) -> f64 {
         let Some(g) = g else { return 0.0 };
-        let (ar, _) = rot(z[2]);
+        let (ar, _) = self.turn.rot(z[2]);
         -g.dot(&((Vector2::new(z[0], z[1]) + ar * self.com) * self.mass))
     }
 }

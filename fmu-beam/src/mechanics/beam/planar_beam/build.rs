@@ -106,6 +106,7 @@ impl PlanarBeam {
             options,
             basis: None,
             counts: TermCounts::default(),
+            turn: Default::default(),
             band: Vec::new(),
             strain: StrainRows::new(length / elements as f64),
         };
