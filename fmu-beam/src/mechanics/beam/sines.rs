@@ -7,9 +7,10 @@ use nalgebra::Matrix2;
 use std::cell::Cell;
 
 /// A body's last angle (by its bits) with its sine and cosine. Held by the body like its
-/// [`super::planar_beam::TermCounts`], not in a thread-local (a unit that a master loads and
-/// unloads keeps no thread-local key behind); a clone carries it along, which changes nothing:
-/// a remembered value is the one `sin_cos` gives.
+/// [`super::planar_beam::TermCounts`], not in a thread-local (which, without native
+/// thread-locals, takes a key of the operating system that a unit loaded and unloaded again
+/// and again might leave behind each time); a clone carries it along, which changes nothing: a
+/// remembered value is the one `sin_cos` gives.
 #[derive(Debug, Clone)]
 pub struct RecentTurn(Cell<(u64, f64, f64)>);
 
