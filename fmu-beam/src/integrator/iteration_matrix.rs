@@ -80,7 +80,8 @@ fn band_split(blocks: &BlockDiagonal) -> Option<(Vec<Range<usize>>, usize)> {
     (!tails.is_empty()).then_some((tails, width))
 }
 
-/// Visits (i, j, entry) of block b of d K_t + c_m M + c_c C_t over its stored entries.
+/// Visits (i, j, entry) of block b of d K_t + c_m M + c_c C_t over its stored entries, column
+/// by column.
 fn for_each_scaled(
     mass: &Block,
     kt: &Block,
@@ -89,11 +90,29 @@ fn for_each_scaled(
     with_tangents: bool,
     mut visit: impl FnMut(usize, usize, f64),
 ) {
+    let scaled = |k: f64, m: f64, c: f64| {
+        if with_tangents {
+            k * w.d + m * w.cm + c * w.cc
+        } else {
+            m * w.cm
+        }
+    };
+    if let (Block::Dense(m), Block::Dense(k), Block::Dense(c)) = (mass, kt, ct) {
+        // dense blocks on their column slices, not through the block's index by kind
+        let n = m.nrows().max(1);
+        let columns = m.as_slice().chunks(n).zip(k.as_slice().chunks(n));
+        for (j, ((mc, kc), cc)) in columns.zip(c.as_slice().chunks(n)).enumerate() {
+            for (i, ((m, k), c)) in mc.iter().zip(kc).zip(cc).enumerate() {
+                visit(i, j, scaled(*k, *m, *c));
+            }
+        }
+        return;
+    }
     mass.for_each_entry(|i, j, mm| {
         let x = if with_tangents {
-            kt[(i, j)] * w.d + mm * w.cm + ct[(i, j)] * w.cc
+            scaled(kt[(i, j)], mm, ct[(i, j)])
         } else {
-            mm * w.cm
+            scaled(0.0, mm, 0.0)
         };
         visit(i, j, x);
     });
@@ -418,31 +437,8 @@ fn assemble_dense(
     n: usize,
 ) {
     jac.as_mut_slice().fill(0.0);
-    let dim = jac.nrows();
     for (b, r) in mass.ranges.iter().enumerate() {
         let (mm, k, c) = (&mass.blocks[b], &kt.blocks[b], &ct.blocks[b]);
-        if let (Block::Dense(mm), Block::Dense(k), Block::Dense(c)) = (mm, k, c) {
-            // column by column on slices (the operations of for_each_scaled, in its order)
-            let nb = mm.nrows();
-            let out = jac.as_mut_slice();
-            for j in 0..nb {
-                let at = (r.start + j) * dim + r.start;
-                let col = &mut out[at..at + nb];
-                let m_col = &mm.as_slice()[j * nb..(j + 1) * nb];
-                if with_tangents {
-                    let k_col = &k.as_slice()[j * nb..(j + 1) * nb];
-                    let c_col = &c.as_slice()[j * nb..(j + 1) * nb];
-                    for (i, x) in col.iter_mut().enumerate() {
-                        *x = k_col[i] * w.d + m_col[i] * w.cm + c_col[i] * w.cc;
-                    }
-                } else {
-                    for (x, m) in col.iter_mut().zip(m_col) {
-                        *x = m * w.cm;
-                    }
-                }
-            }
-            continue;
-        }
         for_each_scaled(mm, k, c, w, with_tangents, |i, j, x| {
             jac[(r.start + i, r.start + j)] = x
         });

@@ -16,17 +16,17 @@ pub struct RecentTurn(Cell<(u64, f64, f64)>);
 
 impl Default for RecentTurn {
     fn default() -> RecentTurn {
-        // a NaN's bits: no angle matches it (a NaN angle is never remembered)
-        RecentTurn(Cell::new((u64::MAX, f64::NAN, f64::NAN)))
+        let (s, c) = 0.0f64.sin_cos();
+        RecentTurn(Cell::new((0.0f64.to_bits(), s, c)))
     }
 }
 
 impl RecentTurn {
-    /// `theta.sin_cos()`, bit for bit.
+    /// `theta.sin_cos()`, bit for bit: what it gave for the same bits.
     pub fn sin_cos(&self, theta: f64) -> (f64, f64) {
         let bits = theta.to_bits();
         let (key, s, c) = self.0.get();
-        if key == bits && !theta.is_nan() {
+        if key == bits {
             return (s, c);
         }
         let (s, c) = theta.sin_cos();
@@ -49,7 +49,7 @@ mod tests {
     }
 
     /// The memo gives `f64::sin_cos` bit for bit: for an angle met again, for angles in turns,
-    /// for -0 against +0, and a NaN (even one with the empty memo's bits) stays a NaN.
+    /// for -0 against +0 (a new memo holds +0), and a NaN stays a NaN.
     #[test]
     fn remembered_sines_are_the_computed_ones() {
         let turn = RecentTurn::default();
@@ -68,11 +68,17 @@ mod tests {
                 }
             }
         }
+        for a in [0.0, -0.0] {
+            assert!(
+                same(RecentTurn::default().sin_cos(a), a.sin_cos()),
+                "{a} first"
+            );
+        }
         for nan in [f64::NAN, f64::from_bits(u64::MAX)] {
-            let (s, c) = RecentTurn::default().sin_cos(nan);
-            assert!(s.is_nan() && c.is_nan());
-            let (s, c) = turn.sin_cos(nan);
-            assert!(s.is_nan() && c.is_nan());
+            for _ in 0..2 {
+                let (s, c) = turn.sin_cos(nan);
+                assert!(s.is_nan() && c.is_nan());
+            }
         }
     }
 }
