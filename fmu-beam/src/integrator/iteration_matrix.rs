@@ -1,7 +1,8 @@
 //! The scaled iteration matrix of the Newton iteration,
 //! [[d K_t + c_m M + c_c C_t, Gᵀ], [G, 0]], assembled from the system's body blocks and
 //! constraint rows ([`crate::mechanics::multibody::sparsity`]) and factorized either dense (nalgebra's LU
-//! with partial pivoting) or sparse (faer's sparse LU: the fill-reducing column ordering and
+//! with partial pivoting, of what is left once the coordinates that a constraint row fixes alone
+//! are condensed out: `condensed.rs`) or sparse (faer's sparse LU: the fill-reducing column ordering and
 //! symbolic analysis once per system, only the numeric factorization at each evaluation) or,
 //! for a beam's banded block, bordered banded (`bordered_band.rs`: the band eliminated first,
 //! the frame coordinates and multipliers last). [`LinearSolver::Auto`] chooses from the
@@ -9,6 +10,7 @@
 //! linear-solvers` (docs/linear_algebra.md), and the bordered band by [`prefers_bordered`].
 
 use super::bordered_band::{BorderedBand, Refusal};
+use super::condensed::Condensed;
 use crate::mechanics::multibody::{Block, BlockDiagonal, Equations, JacobianRows, Point};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{
@@ -156,9 +158,12 @@ type DenseLu = (DMatrix<f64>, Option<LU<f64, Dyn, Dyn>>);
 
 #[derive(Debug, Clone)]
 enum Factors {
+    /// The whole LU, or, where constraint rows fix coordinates alone and the system condenses
+    /// ([`Equations::condenses`]), the LU of the rest (`condensed.rs`).
     Dense {
         jac: DMatrix<f64>,
         lu: Option<LU<f64, Dyn, Dyn>>,
+        condensed: Option<Box<Condensed>>,
     },
     Sparse(Box<SparseLu>),
     /// The bordered banded LU, and the dense LU it falls back to where it refuses.
@@ -191,6 +196,7 @@ impl IterationMatrix {
         let dense = || Factors::Dense {
             jac: DMatrix::zeros(n + m, n + m),
             lu: None,
+            condensed: sys.condenses().then(Box::default),
         };
         let factors = if let Some((tails, width)) = bordered {
             Factors::Bordered {
@@ -254,7 +260,12 @@ impl IterationMatrix {
     pub fn forget(&mut self) {
         self.factored = false;
         match &mut self.factors {
-            Factors::Dense { lu, .. } => *lu = None,
+            Factors::Dense { lu, condensed, .. } => {
+                *lu = None;
+                if let Some(c) = condensed {
+                    c.forget();
+                }
+            }
             Factors::Bordered { dense, .. } => {
                 if let Some(d) = dense {
                     d.1 = None;
@@ -301,12 +312,17 @@ impl IterationMatrix {
         self.cm = w.cm;
         let (mass, kt, ct, rows) = (&self.mass, &self.kt, &self.ct, &self.rows);
         self.factored = match &mut self.factors {
-            Factors::Dense { jac, lu } => {
+            Factors::Dense { jac, lu, condensed } => {
                 assemble_dense(jac, (mass, kt, ct), rows, w, with_tangents, n);
-                let f = jac.clone().lu();
-                let ok = f.is_invertible();
-                *lu = ok.then_some(f);
-                ok
+                *lu = None;
+                if let Some(ok) = condensed.as_mut().and_then(|c| c.factorize(jac, n)) {
+                    ok
+                } else {
+                    let f = jac.clone().lu();
+                    let ok = f.is_invertible();
+                    *lu = ok.then_some(f);
+                    ok
+                }
             }
             Factors::Sparse(s) => {
                 let mut p = s.block_positions.iter();
@@ -397,7 +413,10 @@ impl IterationMatrix {
         }
         debug_assert_eq!(rhs.len(), self.n + self.m);
         match &mut self.factors {
-            Factors::Dense { lu, .. } => lu.as_ref().is_some_and(|lu| lu.solve_mut(rhs)),
+            Factors::Dense { lu, condensed, .. } => match lu {
+                Some(lu) => lu.solve_mut(rhs),
+                None => condensed.as_mut().is_some_and(|c| c.solve_mut(rhs)),
+            },
             Factors::Sparse(s) => {
                 // the slice's iterator, not nalgebra's strided one (every Newton iteration)
                 let finite = all_finite(rhs);

@@ -5,6 +5,7 @@
 
 pub(crate) mod bordered_band;
 pub(crate) mod codec;
+pub(crate) mod condensed;
 pub(crate) mod dense_output;
 pub(crate) mod generalized_alpha;
 pub(crate) mod given_start;

@@ -214,4 +214,7 @@ impl Equations for Mechanics {
     fn turning(&self) -> Option<Turning> {
         each!(self, s => Equations::turning(s))
     }
+    fn condenses(&self) -> bool {
+        each!(self, s => Equations::condenses(s))
+    }
 }

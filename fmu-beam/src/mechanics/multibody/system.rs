@@ -618,4 +618,7 @@ impl super::equations::Equations for System {
     fn turning(&self) -> Option<Turning> {
         Some(System::turning(self))
     }
+    fn condenses(&self) -> bool {
+        true
+    }
 }
