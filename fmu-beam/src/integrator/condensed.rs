@@ -6,8 +6,8 @@
 //! acts on that coordinate's row alone (the matrix holds G and Gᵀ), and the pair (coordinate,
 //! multiplier) leaves the system exactly: the row gives the coordinate's correction, the
 //! coordinate's own row the multiplier's after the rest is solved. The rest is one LU smaller by
-//! two unknowns per pair; the slider-crank with a rigid crank solves 15 instead of 23 (its crank
-//! pivot and its slider fix four coordinates).
+//! two unknowns per pair; the slider-crank with a rigid crank and a rod of 2 elements solves 15
+//! instead of 23 (its crank pivot and its slider fix four coordinates).
 //!
 //! The solution is the one of the whole matrix (the pairs are its first pivots, 2 × 2 blocks
 //! [[s, g], [g, 0]] with g ≠ 0); the arithmetic differs in its rounding only.
