@@ -122,7 +122,10 @@ impl Condensed {
             }
             self.lu = Some(lu);
         }
-        self.kept_x = DVector::zeros(r);
+        // the workspace of the kept unknowns, allocated again only where their number changes
+        if self.kept_x.len() != r {
+            self.kept_x = DVector::zeros(r);
+        }
         self.fixed_x.resize(p, 0.0);
         self.multipliers.resize(p, 0.0);
         self.factored = true;
