@@ -331,6 +331,21 @@ pub const RANGES: &[(Rule, f64)] = &[
     (TIME_RANGE, 1e9),
 ];
 
+/// The least bound of [`RANGES`]: a number within it is within every range.
+pub const LEAST_RANGE: f64 = least_bound(RANGES);
+
+const fn least_bound(ranges: &[(Rule, f64)]) -> f64 {
+    let mut least = f64::INFINITY;
+    let mut k = 0;
+    while k < ranges.len() {
+        if ranges[k].1 < least {
+            least = ranges[k].1;
+        }
+        k += 1;
+    }
+    least
+}
+
 /// The range rule and bound of the quantity at `field`, if it has one.
 pub fn range_of(field: &str) -> Option<&'static (Rule, f64)> {
     RANGES
@@ -1365,6 +1380,8 @@ mod tests {
             Some("time_range")
         );
         assert_eq!(range_of("solver.rho_inf"), None);
+        assert_eq!(LEAST_RANGE, 1e4);
+        assert!(RANGES.iter().all(|(_, bound)| *bound >= LEAST_RANGE));
     }
 
     #[test]

@@ -94,6 +94,11 @@ impl Checker<'_> {
         if !v.is_finite() {
             return Err(self.fail(&r::FINITE, field, Short(v)));
         }
+        // within every range's bound: no rule to look up (most numbers of a scene; the lookup
+        // matches the field against each range's patterns)
+        if v.abs() <= r::LEAST_RANGE {
+            return Ok(());
+        }
         match r::range_of(field) {
             Some((rule, bound)) if v.abs() > *bound => Err(self.fail(rule, field, Short(v))),
             _ => Ok(()),
