@@ -68,6 +68,27 @@ fn ranges_with_a_physical_reason() {
     }
 }
 
+/// The ranges with the least bound (1e4: gravity and lengths) refuse a number just past it and
+/// take the bound itself: validation looks a field's range up only for numbers past the least
+/// bound of all ranges, and the edge of that shortcut is the edge of these rules.
+#[test]
+fn the_least_bound_is_kept_at_its_edge() {
+    let (field, code, _) = refusal(|s| s.world.gravity[1] = -1.0001e4);
+    assert_eq!(
+        (field.as_str(), code),
+        ("world.gravity[1]", "gravity_range")
+    );
+    let (field, code, _) = refusal(|s| s.beams[0].length = 1.0001e4);
+    assert_eq!(
+        (field.as_str(), code),
+        ("beam \"beam\".length", "length_range")
+    );
+    let mut s = scene("flexible_pendulum.toml");
+    s.world.gravity[1] = -1e4;
+    Scene::from_toml_str(&s.to_toml_string(), "at the bound")
+        .expect("the bound itself is in range");
+}
+
 /// The same rules refuse the values set on an instance, in short form too.
 #[test]
 fn values_set_on_an_instance_are_refused_in_short_form() {
