@@ -501,3 +501,29 @@ fn fixed_steps_converge_as_they_shrink() {
         assert!(errors[2..].iter().all(|&e| e < 1e-7), "{errors:?}");
     }
 }
+
+/// A body's mass matrix over ż, built block by block, is the triple product Tᵀ M_v T to
+/// rounding, for a deformed beam at a general quaternion and for a rigid body.
+#[test]
+fn mass_matrix_is_the_triple_product() {
+    use crate::mechanics::beam::spatial_beam::SpatialBeam;
+    use crate::mechanics::multibody3d::body::{frame_of, Body3, FRAME};
+    use nalgebra::DVector;
+    let beam = SpatialBeam::new("beam", &c5_beam(0.3, 2, 0.0));
+    let rigid = RigidBody3::of_beam(&beam, Vec::new());
+    for body in [Body3::Beam(Box::new(beam)), Body3::Rigid(rigid)] {
+        let n = FRAME + body.nflex();
+        let p = Vector4::new(0.8, -0.3, 0.4, 0.2).normalize();
+        let z = DVector::from_fn(n, |k, _| match k {
+            3..=6 => p[k - 3],
+            k => 1e-3 * ((k * 7 % 5) as f64 - 2.0),
+        });
+        let (_, p, a) = frame_of(&z.rows(0, n));
+        let t = body.velocity_map(&p);
+        let dense = t.transpose() * body.mass_matrix_v(&a, z.rows(FRAME, body.nflex())) * &t;
+        let m = body.mass_matrix(z.rows(0, n));
+        let scale = dense.amax();
+        assert!((&m - &dense).amax() <= 1e-14 * scale, "{m} vs {dense}");
+        assert!((&m - m.transpose()).amax() <= 1e-14 * scale, "symmetric");
+    }
+}

@@ -92,12 +92,39 @@ impl Body3 {
         }
     }
 
-    /// Mass matrix over ż: Tᵀ M_v T.
+    /// Mass matrix over ż: Tᵀ M_v T, block by block. T ([`Body3::velocity_map`]) is the
+    /// identity but for ω = B ṗ (B = 2 G(p), 3 × 4), so the rows and columns of R and q_f copy
+    /// M_v's and those of p are B's products with its ω rows and columns: the dense triple
+    /// product spent most of its work on T's zeros (a third of the 3D roll-up's run went to
+    /// the damping's mass matrices, one a body at every residual).
     pub fn mass_matrix(&self, z: DVectorView<f64>) -> DMatrix<f64> {
         let (_, p, a) = frame_of(&z);
-        let t = self.velocity_map(&p);
-        let mv = self.mass_matrix_v(&a, z.rows(FRAME, self.nflex()));
-        t.transpose() * mv * t
+        let nf = self.nflex();
+        let mv = self.mass_matrix_v(&a, z.rows(FRAME, nf));
+        let b = g_body(&p) * 2.0;
+        // M_v's index of each coordinate of z that T maps to itself: R and q_f
+        let kept = |k: usize| if k < 3 { k } else { k - 1 };
+        let others: Vec<usize> = (0..3).chain(FRAME..FRAME + nf).collect();
+        let n = FRAME + nf;
+        let mut m = DMatrix::zeros(n, n);
+        for &i in &others {
+            for &j in &others {
+                m[(i, j)] = mv[(kept(i), kept(j))];
+            }
+            // (M_v B)'s row i and (Bᵀ M_v)'s column i
+            for c in 0..4 {
+                let (mut right, mut left) = (0.0, 0.0);
+                for w in 0..3 {
+                    right += mv[(kept(i), 3 + w)] * b[(w, c)];
+                    left += b[(w, c)] * mv[(3 + w, kept(i))];
+                }
+                m[(i, 3 + c)] = right;
+                m[(3 + c, i)] = left;
+            }
+        }
+        let bt_mww = b.transpose() * mv.fixed_view::<3, 3>(3, 3);
+        m.fixed_view_mut::<4, 4>(3, 3).copy_from(&(bt_mww * b));
+        m
     }
 
     /// Residual over v: inertia + internal − gravity.
