@@ -95,7 +95,7 @@ impl Body3 {
     /// Mass matrix over ż: Tᵀ M_v T, block by block. T ([`Body3::velocity_map`]) is the
     /// identity but for ω = B ṗ (B = 2 G(p), 3 × 4), so the rows and columns of R and q_f copy
     /// M_v's and those of p are B's products with its ω rows and columns: the dense triple
-    /// product spent most of its work on T's zeros (a third of the 3D roll-up's run went to
+    /// product spent most of its work on T's zeros (a fifth of the 3D roll-up's run went to
     /// the damping's mass matrices, one a body at every residual).
     pub fn mass_matrix(&self, z: DVectorView<f64>) -> DMatrix<f64> {
         let (_, p, a) = frame_of(&z);
