@@ -529,9 +529,16 @@ impl SpatialBeam {
         &self,
         a: &Matrix3<f64>,
         f: impl Into<DVectorView<'a, f64>>,
-        mut m: DMatrixViewMut<f64>,
+        m: DMatrixViewMut<f64>,
     ) {
-        let FlexInertia { c, ithth, ithf, .. } = self.flex_inertia(f);
+        self.mass_matrix_of(&self.flex_inertia(f), a, m);
+    }
+
+    /// [`SpatialBeam::mass_matrix`] from the q_f-dependent inertia at hand (a residual's
+    /// products hold it).
+    pub fn mass_matrix_of(&self, fi: &FlexInertia, a: &Matrix3<f64>, mut m: DMatrixViewMut<f64>) {
+        let FlexInertia { c, ithth, ithf, .. } = fi;
+        let (c, ithth) = (*c, *ithth);
         let nf = self.nflex();
         m.fill(0.0);
         let mrr = Matrix3::identity() * self.mass;
@@ -543,7 +550,7 @@ impl SpatialBeam {
         m.view_mut((OMEGA, OMEGA), (3, 3)).copy_from(&ithth);
         m.view_mut((0, FLEX), (3, nf)).copy_from(&mrf);
         m.view_mut((FLEX, 0), (nf, 3)).copy_from(&mrf.transpose());
-        m.view_mut((OMEGA, FLEX), (3, nf)).copy_from(&ithf);
+        m.view_mut((OMEGA, FLEX), (3, nf)).copy_from(ithf);
         m.view_mut((FLEX, OMEGA), (nf, 3))
             .copy_from(&ithf.transpose());
         m.view_mut((FLEX, FLEX), (nf, nf)).copy_from(&self.mff);

@@ -99,9 +99,38 @@ impl Body3 {
     /// the damping's mass matrices, one a body at every residual).
     pub fn mass_matrix(&self, z: DVectorView<f64>) -> DMatrix<f64> {
         let (_, p, a) = frame_of(&z);
+        self.mass_matrix_over_z(&p, &self.mass_matrix_v(&a, z.rows(FRAME, self.nflex())))
+    }
+
+    /// The residual over ż and the mass matrix over ż at z, a beam's q_f-dependent inertia
+    /// computed once for both (the beams' α damping needs the mass matrix of every body at
+    /// every residual).
+    pub fn residual_and_mass(
+        &self,
+        z: DVectorView<f64>,
+        zd: DVectorView<f64>,
+        zdd: DVectorView<f64>,
+        g: &Vector3<f64>,
+    ) -> (DVector<f64>, DMatrix<f64>) {
+        let pr = self.products(&z, &zd, &zdd);
+        let r = self.residual_with(pr.as_ref(), z, zd, zdd, g);
+        let (_, p, a) = frame_of(&z);
+        let mv = match (self, &pr) {
+            (Body3::Beam(b), Some(pr)) => {
+                let n = b.ndof();
+                let mut mv = DMatrix::zeros(n, n);
+                b.mass_matrix_of(&pr.inertia, &a, mv.view_mut((0, 0), (n, n)));
+                mv
+            }
+            _ => self.mass_matrix_v(&a, z.rows(FRAME, self.nflex())),
+        };
+        (r, self.mass_matrix_over_z(&p, &mv))
+    }
+
+    /// Tᵀ M_v T for the mass matrix `mv` over v, at the frame's quaternion `p`.
+    fn mass_matrix_over_z(&self, p: &Vector4<f64>, mv: &DMatrix<f64>) -> DMatrix<f64> {
         let nf = self.nflex();
-        let mv = self.mass_matrix_v(&a, z.rows(FRAME, nf));
-        let b = g_body(&p) * 2.0;
+        let b = g_body(p) * 2.0;
         // M_v's index of each coordinate of z that T maps to itself: R and q_f
         let kept = |k: usize| if k < 3 { k } else { k - 1 };
         let others: Vec<usize> = (0..3).chain(FRAME..FRAME + nf).collect();

@@ -16,15 +16,36 @@ impl System3 {
     /// The α damping of beam `g` at q, `None` when it has none (α = 0, damping off, or a
     /// rigid bar).
     pub fn beam_damping(&self, g: usize, q: &DVector<f64>) -> Option<BeamDamping> {
+        self.beam_damping_with(g, q, |i| self.bodies[i].mass_matrix(self.body_coords(i, q)))
+    }
+
+    /// Whether beam `g` has α damping.
+    pub fn damps(&self, g: usize) -> bool {
+        let group = &self.beams[g];
+        let (first, last) = (group.bodies.start, group.bodies.end - 1);
+        matches!(
+            (&self.bodies[first], &self.bodies[last]),
+            (Body3::Beam(beam), Body3::Beam(_)) if beam.rayleigh_alpha != 0.0
+        )
+    }
+
+    /// [`System3::beam_damping`] with each body's mass matrix over ż at q from `mass` (body
+    /// index to matrix: the residual has them at hand).
+    pub fn beam_damping_with(
+        &self,
+        g: usize,
+        q: &DVector<f64>,
+        mut mass: impl FnMut(usize) -> DMatrix<f64>,
+    ) -> Option<BeamDamping> {
+        if !self.damps(g) {
+            return None;
+        }
         let group = &self.beams[g];
         let (first, last) = (group.bodies.start, group.bodies.end - 1);
         let (Body3::Beam(beam), Body3::Beam(last_beam)) = (&self.bodies[first], &self.bodies[last])
         else {
             return None;
         };
-        if beam.rayleigh_alpha == 0.0 {
-            return None;
-        }
         let ja = self.map_jacobian(first, &beam.flange_a, q);
         let origin = ja.0;
         let bodies: Vec<DampedBody> = group
@@ -48,7 +69,7 @@ impl System3 {
                 DampedBody {
                     body: i,
                     offset: self.offsets[i],
-                    mass: self.bodies[i].mass_matrix(z),
+                    mass: mass(i),
                     rigid,
                     reference: None,
                 }

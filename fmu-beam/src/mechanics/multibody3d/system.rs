@@ -643,18 +643,38 @@ impl Equations for System3 {
         r: &mut DVector<f64>,
     ) {
         let g = self.gravity.unwrap_or_default();
+        // the bodies of beams with α damping, whose mass matrices the damping needs: each is
+        // built from the inertia its residual computes anyway
+        let mut damped = vec![false; self.bodies.len()];
+        for (k, group) in self.beams.iter().enumerate() {
+            if self.damps(k) {
+                group.bodies.clone().for_each(|i| damped[i] = true);
+            }
+        }
+        let mut masses: Vec<Option<DMatrix<f64>>> = vec![None; self.bodies.len()];
         for (i, b) in self.bodies.iter().enumerate() {
             let (o, n) = (self.offsets[i], b.ncoords());
-            let ri = b.residual(
+            let (z, zd, zdd) = (
                 self.body_coords(i, q),
                 self.body_coords(i, v),
                 self.body_coords(i, a),
-                &g,
             );
+            let ri = if damped[i] {
+                let (ri, mi) = b.residual_and_mass(z, zd, zdd, &g);
+                masses[i] = Some(mi);
+                ri
+            } else {
+                b.residual(z, zd, zdd, &g)
+            };
             r.rows_mut(o, n).copy_from(&ri);
         }
         for g in 0..self.beams.len() {
-            if let Some(d) = self.beam_damping(g, q) {
+            let mass = |i: usize| {
+                masses[i]
+                    .take()
+                    .unwrap_or_else(|| self.bodies[i].mass_matrix(self.body_coords(i, q)))
+            };
+            if let Some(d) = self.beam_damping_with(g, q, mass) {
                 d.add_force(v, r);
             }
         }
