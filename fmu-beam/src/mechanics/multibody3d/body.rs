@@ -133,11 +133,11 @@ impl Body3 {
         let b = g_body(p) * 2.0;
         // M_v's index of each coordinate of z that T maps to itself: R and q_f
         let kept = |k: usize| if k < 3 { k } else { k - 1 };
-        let others: Vec<usize> = (0..3).chain(FRAME..FRAME + nf).collect();
+        let others = || (0..3).chain(FRAME..FRAME + nf);
         let n = FRAME + nf;
         let mut m = DMatrix::zeros(n, n);
-        for &i in &others {
-            for &j in &others {
+        for i in others() {
+            for j in others() {
                 m[(i, j)] = mv[(kept(i), kept(j))];
             }
             // (M_v B)'s row i and (Bᵀ M_v)'s column i
